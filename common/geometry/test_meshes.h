@@ -1,0 +1,117 @@
+// Small exact meshes for unit tests (header-only; tests only). Richer
+// procedural shapes live in common/synth.
+#ifndef MESHSEEK_COMMON_GEOMETRY_TEST_MESHES_H_
+#define MESHSEEK_COMMON_GEOMETRY_TEST_MESHES_H_
+
+#include <cmath>
+#include <map>
+#include <utility>
+
+#include "common/geometry/mesh.h"
+
+namespace meshseek {
+namespace testing_meshes {
+
+// Axis-aligned cube [-h, h]^3, 12 outward-facing triangles, 8 shared vertices.
+inline TriangleMesh Cube(float h = 1.0f) {
+  TriangleMesh m;
+  for (int i = 0; i < 8; ++i) {
+    m.vertices.emplace_back(i & 1 ? h : -h, i & 2 ? h : -h, i & 4 ? h : -h);
+  }
+  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return m;
+}
+
+// Square [-h, h]^2 in the plane z = z0, split into (2n)^2 cells of 2 triangles.
+inline TriangleMesh Plane(int n, float h = 1.0f, float z0 = 0.0f) {
+  TriangleMesh m;
+  const int k = 2 * n;
+  for (int j = 0; j <= k; ++j) {
+    for (int i = 0; i <= k; ++i) {
+      m.vertices.emplace_back(-h + 2 * h * i / k, -h + 2 * h * j / k, z0);
+    }
+  }
+  for (int j = 0; j < k; ++j) {
+    for (int i = 0; i < k; ++i) {
+      const uint32_t a = j * (k + 1) + i, b = a + 1, c = a + (k + 1), d = c + 1;
+      m.triangles.push_back({a, b, d});
+      m.triangles.push_back({a, d, c});
+    }
+  }
+  return m;
+}
+
+// Icosphere of radius r: an icosahedron subdivided `levels` times, vertices
+// projected to the sphere. 20 * 4^levels triangles.
+inline TriangleMesh Icosphere(int levels, float r = 1.0f) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Vec3d> v = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                          {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  for (auto& p : v) p = Normalized(p);
+  std::vector<Triangle> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                             {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                             {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                             {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (int l = 0; l < levels; ++l) {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
+    auto midpoint = [&](uint32_t a, uint32_t b) {
+      const auto key = std::make_pair(std::min(a, b), std::max(a, b));
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      v.push_back(Normalized((v[a] + v[b]) * 0.5));
+      const uint32_t idx = static_cast<uint32_t>(v.size() - 1);
+      mid[key] = idx;
+      return idx;
+    };
+    std::vector<Triangle> next;
+    for (const Triangle& tri : f) {
+      const uint32_t a = midpoint(tri[0], tri[1]), b = midpoint(tri[1], tri[2]),
+                     c = midpoint(tri[2], tri[0]);
+      next.push_back({tri[0], a, c});
+      next.push_back({tri[1], b, a});
+      next.push_back({tri[2], c, b});
+      next.push_back({a, b, c});
+    }
+    f = std::move(next);
+  }
+  TriangleMesh m;
+  for (const auto& p : v) m.vertices.emplace_back(p * static_cast<double>(r));
+  m.triangles = std::move(f);
+  return m;
+}
+
+// Copy of `mesh` in which every triangle has its own three vertices.
+inline TriangleMesh ToSoup(const TriangleMesh& mesh) {
+  TriangleMesh soup;
+  for (const Triangle& t : mesh.triangles) {
+    const uint32_t base = static_cast<uint32_t>(soup.vertices.size());
+    for (uint32_t v : t) soup.vertices.push_back(mesh.vertices[v]);
+    soup.triangles.push_back({base, base + 1, base + 2});
+  }
+  return soup;
+}
+
+// Appends `part` to `mesh` without welding.
+inline void Append(const TriangleMesh& part, TriangleMesh* mesh) {
+  const uint32_t base = static_cast<uint32_t>(mesh->vertices.size());
+  mesh->vertices.insert(mesh->vertices.end(), part.vertices.begin(), part.vertices.end());
+  for (const Triangle& t : part.triangles) {
+    mesh->triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+}
+
+// Rotation matrix (row-major) about a unit axis by `angle` radians.
+inline std::array<double, 9> AxisAngle(Vec3d axis, double angle) {
+  axis = Normalized(axis);
+  const double c = std::cos(angle), s = std::sin(angle), C = 1 - c;
+  const double x = axis.x, y = axis.y, z = axis.z;
+  return {c + x * x * C,     x * y * C - z * s, x * z * C + y * s,
+          y * x * C + z * s, c + y * y * C,     y * z * C - x * s,
+          z * x * C - y * s, z * y * C + x * s, c + z * z * C};
+}
+
+}  // namespace testing_meshes
+}  // namespace meshseek
+
+#endif  // MESHSEEK_COMMON_GEOMETRY_TEST_MESHES_H_
