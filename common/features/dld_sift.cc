@@ -1,0 +1,85 @@
+#include "common/features/dld_sift.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "common/base/status_macros.h"
+#include "common/geometry/enclosing_sphere.h"
+#include "common/geometry/point_grid.h"
+#include "common/geometry/principal_axes.h"
+#include "common/geometry/surface_sampler.h"
+#include "common/geometry/triangle_bvh.h"
+
+namespace meshseek {
+
+absl::Status DldSiftOptions::Validate() const {
+  if (num_points < 1 || num_points > 1000000) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("DLD-SIFT num_points must be in [1, 1000000], got ", num_points));
+  }
+  if (!(scale > 0) || scale > 2) {
+    return absl::InvalidArgumentError(absl::StrCat("DLD-SIFT scale E must be in (0, 2], got ", scale));
+  }
+  if (frame_samples_per_support < 8) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "DLD-SIFT frame_samples_per_support must be >= 8, got ", frame_samples_per_support));
+  }
+  if (min_frame_samples < 16 || max_frame_samples < min_frame_samples) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("DLD-SIFT frame sample bounds must satisfy 16 <= min <= max, got min ",
+                     min_frame_samples, ", max ", max_frame_samples));
+  }
+  MESHSEEK_RETURN_IF_ERROR(depth_image.Validate());
+  return descriptor.Validate();
+}
+
+absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh, const DldSiftOptions& options) {
+  MESHSEEK_RETURN_IF_ERROR(options.Validate());
+  MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));
+  MESHSEEK_ASSIGN_OR_RETURN(const Sphere sphere, MinimumEnclosingSphere(mesh));
+  const double s = options.scale * sphere.radius;
+  if (!(s > 0)) {
+    return absl::InvalidArgumentError("model has zero extent (all vertices coincide)");
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(const SurfacePoints centres, SampleSurface(mesh, options.num_points));
+
+  const double area = SurfaceArea(mesh);
+  const double wanted = options.frame_samples_per_support * area / (M_PI * s * s);
+  const int64_t frame_count = static_cast<int64_t>(std::clamp<double>(
+      std::ceil(wanted), options.min_frame_samples, options.max_frame_samples));
+  MESHSEEK_ASSIGN_OR_RETURN(const SurfacePoints dense, SampleSurface(mesh, frame_count));
+  const PointGrid grid(dense.positions, static_cast<float>(s));
+  const TriangleBvh bvh(mesh);
+  DepthImageRenderer renderer(mesh, bvh, options.depth_image);
+  DepthSiftDescriber describer(options.descriptor);
+
+  LocalFeatures features;
+  features.keypoints.reserve(2 * centres.size());
+  features.descriptors.reserve(2 * centres.size() * kSiftDimension);
+  std::vector<uint32_t> support;
+  DepthImage front, back;
+  uint8_t descriptor[kSiftDimension];
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    const Vec3f& p = centres.positions[i];
+    support.clear();
+    grid.RadiusQuery(p, static_cast<float>(s), &support);
+    if (support.size() < 3) continue;
+    const PrincipalAxes axes = ComputePrincipalAxes(dense.positions, &support);
+    const ViewFrame frame{Vec3d(p), axes.axes[0], axes.axes[2], s};
+    renderer.RenderPair(frame, &front, options.two_views ? &back : nullptr);
+    for (int view = 0; view < (options.two_views ? 2 : 1); ++view) {
+      DepthImage& image = view == 0 ? front : back;
+      if (!FinishDepthImage(&image) || !describer.Describe(image, descriptor)) continue;
+      const Vec3f forward(view == 0 ? -frame.normal : frame.normal);
+      features.keypoints.push_back({p, forward, Vec3f(frame.up), static_cast<float>(s), 0});
+      features.descriptors.insert(features.descriptors.end(), descriptor, descriptor + kSiftDimension);
+    }
+  }
+  if (features.keypoints.empty()) {
+    return absl::InvalidArgumentError("DLD-SIFT found no usable feature point on the model");
+  }
+  return features;
+}
+
+}  // namespace meshseek

@@ -1,0 +1,74 @@
+// SIFT descriptors of local depth images (DESIGN.md 2.3).
+//
+// One 128-d descriptor (4 x 4 spatial cells x 8 orientations) centred on the
+// image and covering it, computed by OpenCV's cv::SIFT from an 8-bit version of
+// the depth image: a keypoint of size I / 6 at the centre gives a descriptor
+// window of 4 cells x 3 sigma = I pixels. Orientation is fixed by the frame
+// (the PCA up axis is "up" in the image), not by Lowe's dominant gradient.
+// Since the sign of the up axis is arbitrary, LD-SIFT adds the descriptor of
+// the image turned by 180 degrees; that turn is an exact permutation of the
+// descriptor's bins (cell (i, j) -> (3 - i, 3 - j), orientation k -> k + 4), so
+// it costs no second SIFT call. The result is normalised as SIFT does (unit
+// length, entries clipped at 0.2, unit length again) and quantised to bytes
+// (x 512, saturated), the usual storage form of SIFT.
+#ifndef MESHSEEK_COMMON_FEATURES_SIFT_DESCRIPTOR_H_
+#define MESHSEEK_COMMON_FEATURES_SIFT_DESCRIPTOR_H_
+
+#include <cstdint>
+#include <memory>
+
+#include "absl/status/status.h"
+#include "common/features/depth_image.h"
+
+namespace meshseek {
+
+inline constexpr int kSiftDimension = 128;
+
+// How depths become the 8-bit grey levels cv::SIFT requires.
+enum class DepthToGray {
+  // grey = 255 * depth / (2 s): the same depth difference gives the same
+  // contrast in every image of the model (scale-invariant, since s scales
+  // with the model).
+  kFixedRange,
+  // The image's own depth range stretched to 0..255: maximal precision for
+  // nearly flat patches, at the price of amplifying small relief.
+  kStretch,
+};
+
+struct SiftDescriptorOptions {
+  /// Mapping from depth to grey level.
+  DepthToGray depth_to_gray = DepthToGray::kFixedRange;
+  /// Add the 180-degree-turned descriptor (LD-SIFT's cure for the sign
+  /// ambiguity of the PCA up axis). Off only for experiments.
+  bool symmetrize_180 = true;
+
+  absl::Status Validate() const;
+};
+
+// Turns float SIFT bins into SIFT's normalised byte form (in place on `bins`,
+// result in `out`).
+void NormalizeSiftDescriptor(float* bins, uint8_t* out);
+
+// The bin permutation of a 180-degree image turn: out[k] = in[Rotate180Index(k)].
+int Rotate180Index(int bin);
+
+// Describes depth images. Holds OpenCV state: one per thread.
+class DepthSiftDescriber {
+ public:
+  explicit DepthSiftDescriber(const SiftDescriptorOptions& options);
+  ~DepthSiftDescriber();
+  DepthSiftDescriber(const DepthSiftDescriber&) = delete;
+  DepthSiftDescriber& operator=(const DepthSiftDescriber&) = delete;
+
+  // Writes kSiftDimension bytes to `out` for a finished image
+  // (FinishDepthImage). Returns false if OpenCV produced no descriptor.
+  bool Describe(const DepthImage& image, uint8_t* out);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_COMMON_FEATURES_SIFT_DESCRIPTOR_H_

@@ -1,0 +1,113 @@
+#include "common/features/sift_descriptor.h"
+
+#include <cmath>
+#include <random>
+#include <set>
+
+#include <gtest/gtest.h>
+
+namespace meshseek {
+namespace {
+
+DepthImage RandomSmoothImage(int size, uint32_t seed) {
+  std::mt19937 rng(seed);
+  DepthImage image;
+  image.size = size;
+  image.support_radius = 1;
+  image.depth.resize(size * size);
+  const double a = rng() % 100 / 50.0 - 1, b = rng() % 100 / 50.0 - 1, c = rng() % 100 / 25.0;
+  for (int r = 0; r < size; ++r) {
+    for (int col = 0; col < size; ++col) {
+      const double x = (col - size / 2) / double(size), y = (r - size / 2) / double(size);
+      image.at(r, col) = static_cast<float>(1 + 0.5 * std::sin(c * x + a) * std::cos(3 * y + b) + 0.3 * x * y);
+    }
+  }
+  return image;
+}
+
+DepthImage Turn180(const DepthImage& in) {
+  DepthImage out = in;
+  for (int r = 0; r < in.size; ++r) {
+    for (int c = 0; c < in.size; ++c) out.at(r, c) = in.at(in.size - 1 - r, in.size - 1 - c);
+  }
+  return out;
+}
+
+double L2(const uint8_t* a, const uint8_t* b) {
+  double s = 0;
+  for (int k = 0; k < kSiftDimension; ++k) s += (a[k] - b[k]) * double(a[k] - b[k]);
+  return std::sqrt(s);
+}
+
+TEST(SiftDescriptorTest, Rotate180IsAnInvolutivePermutation) {
+  std::set<int> seen;
+  for (int k = 0; k < kSiftDimension; ++k) {
+    seen.insert(Rotate180Index(k));
+    EXPECT_EQ(Rotate180Index(Rotate180Index(k)), k);
+  }
+  EXPECT_EQ(seen.size(), 128u);
+}
+
+TEST(SiftDescriptorTest, SymmetrisedDescriptorIgnoresTheUpAxisSign) {
+  DepthSiftDescriber describer{SiftDescriptorOptions()};
+  for (uint32_t seed = 0; seed < 5; ++seed) {
+    const DepthImage image = RandomSmoothImage(21, seed);
+    uint8_t a[kSiftDimension], b[kSiftDimension];
+    ASSERT_TRUE(describer.Describe(image, a));
+    ASSERT_TRUE(describer.Describe(Turn180(image), b));
+    // Byte rounding and OpenCV's border handling allow a few units per bin.
+    EXPECT_LT(L2(a, b), 12.0) << "seed " << seed;
+  }
+}
+
+TEST(SiftDescriptorTest, PermutationMatchesOpenCvOnTurnedImage) {
+  // Without symmetrisation, the descriptor of the turned image is the
+  // permuted descriptor: this checks Rotate180Index against OpenCV's layout.
+  SiftDescriptorOptions options;
+  options.symmetrize_180 = false;
+  DepthSiftDescriber describer(options);
+  const DepthImage image = RandomSmoothImage(21, 42);
+  uint8_t a[kSiftDimension], b[kSiftDimension], permuted[kSiftDimension];
+  ASSERT_TRUE(describer.Describe(image, a));
+  ASSERT_TRUE(describer.Describe(Turn180(image), b));
+  for (int k = 0; k < kSiftDimension; ++k) permuted[k] = a[Rotate180Index(k)];
+  EXPECT_LT(L2(permuted, b), 12.0);
+  EXPECT_GT(L2(a, b), 40.0);  // and the turn does change the raw descriptor
+}
+
+TEST(SiftDescriptorTest, DescriptorIsNormalisedAndDistinguishesImages) {
+  DepthSiftDescriber describer{SiftDescriptorOptions()};
+  uint8_t a[kSiftDimension], b[kSiftDimension];
+  ASSERT_TRUE(describer.Describe(RandomSmoothImage(21, 1), a));
+  ASSERT_TRUE(describer.Describe(RandomSmoothImage(21, 2), b));
+  double sq = 0;
+  for (int k = 0; k < kSiftDimension; ++k) sq += a[k] * double(a[k]);
+  EXPECT_NEAR(std::sqrt(sq), 512.0, 10.0);
+  EXPECT_GT(L2(a, b), 50.0);
+}
+
+TEST(SiftDescriptorTest, ContrastScaleDoesNotMatterWithStretch) {
+  SiftDescriptorOptions options;
+  options.depth_to_gray = DepthToGray::kStretch;
+  DepthSiftDescriber describer(options);
+  DepthImage image = RandomSmoothImage(21, 3);
+  DepthImage scaled = image;
+  for (float& d : scaled.depth) d = 0.1f + 0.5f * d;
+  uint8_t a[kSiftDimension], b[kSiftDimension];
+  ASSERT_TRUE(describer.Describe(image, a));
+  ASSERT_TRUE(describer.Describe(scaled, b));
+  EXPECT_LT(L2(a, b), 12.0);
+}
+
+TEST(NormalizeSiftDescriptorTest, ClipsAndScales) {
+  float bins[kSiftDimension] = {};
+  bins[0] = 100;  // one dominant bin is clipped at 0.2 then renormalised to 1
+  bins[1] = 1;
+  uint8_t out[kSiftDimension];
+  NormalizeSiftDescriptor(bins, out);
+  EXPECT_EQ(out[0], 255);  // 512 saturates
+  EXPECT_GT(out[1], 0);
+}
+
+}  // namespace
+}  // namespace meshseek
