@@ -1,6 +1,7 @@
 #include "common/geometry/triangle_bvh.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 namespace meshseek {
@@ -17,7 +18,7 @@ void Aabb::Extend(const Aabb& b) {
 
 TriangleBvh::TriangleBvh(const TriangleMesh& mesh) {
   const std::size_t n = mesh.triangles.size();
-  triangle_boxes_.resize(n);
+  std::vector<Aabb> boxes(n);
   std::vector<Vec3f> centroids(n);
   for (std::size_t t = 0; t < n; ++t) {
     Aabb box;
@@ -26,21 +27,22 @@ TriangleBvh::TriangleBvh(const TriangleMesh& mesh) {
       box.Extend(mesh.vertices[v]);
       sum += mesh.vertices[v];
     }
-    triangle_boxes_[t] = box;
+    boxes[t] = box;
     centroids[t] = sum / 3.0f;
   }
   order_.resize(n);
   std::iota(order_.begin(), order_.end(), 0u);
   nodes_.reserve(n > 0 ? 2 * (n / kLeafSize + 1) : 0);
-  if (n > 0) Build(0, static_cast<uint32_t>(n), centroids);
+  if (n > 0) Build(0, static_cast<uint32_t>(n), boxes, centroids);
 }
 
-uint32_t TriangleBvh::Build(uint32_t begin, uint32_t end, const std::vector<Vec3f>& centroids) {
+uint32_t TriangleBvh::Build(uint32_t begin, uint32_t end, const std::vector<Aabb>& boxes,
+                            const std::vector<Vec3f>& centroids) {
   const uint32_t index = static_cast<uint32_t>(nodes_.size());
   nodes_.push_back({});
   Aabb box, centroid_box;
   for (uint32_t i = begin; i < end; ++i) {
-    box.Extend(triangle_boxes_[order_[i]]);
+    box.Extend(boxes[order_[i]]);
     centroid_box.Extend(centroids[order_[i]]);
   }
   nodes_[index].box = box;
@@ -57,14 +59,43 @@ uint32_t TriangleBvh::Build(uint32_t begin, uint32_t end, const std::vector<Vec3
                      const float ca = centroids[a][axis], cb = centroids[b][axis];
                      return ca < cb || (ca == cb && a < b);
                    });
-  Build(begin, mid, centroids);
-  const uint32_t right = Build(mid, end, centroids);
+  Build(begin, mid, boxes, centroids);
+  const uint32_t right = Build(mid, end, boxes, centroids);
   nodes_[index].first = right;
   nodes_[index].count = 0;
   return index;
 }
 
+bool OrientedBox::MayOverlap(const Aabb& box) const {
+  const Vec3d box_center = (Vec3d(box.min) + Vec3d(box.max)) * 0.5;
+  const Vec3d box_half = (Vec3d(box.max) - Vec3d(box.min)) * 0.5;
+  const Vec3d d = center - box_center;
+  for (int j = 0; j < 3; ++j) {  // world axes
+    double reach = box_half[j];
+    for (int i = 0; i < 3; ++i) reach += half_extents[i] * std::abs(axes[i][j]);
+    if (std::abs(d[j]) > reach) return false;
+  }
+  for (int i = 0; i < 3; ++i) {  // box axes
+    double reach = half_extents[i];
+    for (int j = 0; j < 3; ++j) reach += box_half[j] * std::abs(axes[i][j]);
+    if (std::abs(Dot(d, axes[i])) > reach) return false;
+  }
+  return true;
+}
+
 void TriangleBvh::Query(const Aabb& box, std::vector<uint32_t>* out) const {
+  Traverse([&box](const Aabb& b) { return b.Overlaps(box); }, out);
+}
+
+void TriangleBvh::Query(const OrientedBox& box, std::vector<uint32_t>* out) const {
+  Traverse([&box](const Aabb& b) { return box.MayOverlap(b); }, out);
+}
+
+// Leaves are tested by their node box only: a leaf's few triangles are cheaper
+// to hand to the caller, which rejects far ones in its own first step, than to
+// test box by box.
+template <typename Overlaps>
+void TriangleBvh::Traverse(const Overlaps& overlaps, std::vector<uint32_t>* out) const {
   if (nodes_.empty()) return;
   uint32_t stack[64];
   int top = 0;
@@ -72,11 +103,9 @@ void TriangleBvh::Query(const Aabb& box, std::vector<uint32_t>* out) const {
   while (top > 0) {
     const uint32_t index = stack[--top];
     const Node& node = nodes_[index];
-    if (!node.box.Overlaps(box)) continue;
+    if (!overlaps(node.box)) continue;
     if (node.count > 0) {
-      for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-        if (triangle_boxes_[order_[i]].Overlaps(box)) out->push_back(order_[i]);
-      }
+      out->insert(out->end(), order_.begin() + node.first, order_.begin() + node.first + node.count);
     } else {
       stack[top++] = node.first;  // right child
       stack[top++] = index + 1;   // left child (depth-first layout)

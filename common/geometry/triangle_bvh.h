@@ -9,6 +9,7 @@
 #ifndef MESHSEEK_COMMON_GEOMETRY_TRIANGLE_BVH_H_
 #define MESHSEEK_COMMON_GEOMETRY_TRIANGLE_BVH_H_
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -28,6 +29,19 @@ struct Aabb {
   }
 };
 
+// A box with arbitrary orientation: centre, three orthonormal axes and the
+// half extent along each.
+struct OrientedBox {
+  Vec3d center;
+  std::array<Vec3d, 3> axes;
+  std::array<double, 3> half_extents{0, 0, 0};
+
+  // Conservative overlap test by separating axes (the 3 world axes and the 3
+  // box axes; edge cross products are skipped, so rare near-misses count as
+  // overlaps).
+  bool MayOverlap(const Aabb& box) const;
+};
+
 class TriangleBvh {
  public:
   static constexpr int kLeafSize = 4;
@@ -37,8 +51,13 @@ class TriangleBvh {
   explicit TriangleBvh(const TriangleMesh& mesh);
 
   // Appends to `out` the index of every triangle whose bounding box overlaps
-  // `box` (a superset of the triangles that intersect it). `out` is not cleared.
+  // `box`, and possibly a few more from the same leaves (a superset of the
+  // triangles that intersect it). `out` is not cleared.
   void Query(const Aabb& box, std::vector<uint32_t>* out) const;
+  // Same for an oriented box: triangles whose bounding box may overlap it.
+  // Much tighter than querying the oriented box's own bounding box when the
+  // box is turned (a depth image's view cube, say).
+  void Query(const OrientedBox& box, std::vector<uint32_t>* out) const;
 
   std::size_t num_nodes() const { return nodes_.size(); }
 
@@ -48,10 +67,12 @@ class TriangleBvh {
     uint32_t first;  // leaf: first index into order_; inner: index of the right child
     uint32_t count;  // leaf: number of triangles; inner: 0
   };
-  uint32_t Build(uint32_t begin, uint32_t end, const std::vector<Vec3f>& centroids);
+  uint32_t Build(uint32_t begin, uint32_t end, const std::vector<Aabb>& boxes,
+                 const std::vector<Vec3f>& centroids);
+  template <typename Overlaps>
+  void Traverse(const Overlaps& overlaps, std::vector<uint32_t>* out) const;
 
   std::vector<Node> nodes_;
-  std::vector<Aabb> triangle_boxes_;
   std::vector<uint32_t> order_;
 };
 
