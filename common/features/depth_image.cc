@@ -17,7 +17,11 @@ absl::Status DepthImageOptions::Validate() const {
 
 DepthImageRenderer::DepthImageRenderer(const TriangleMesh& mesh, const TriangleBvh& bvh,
                                        const DepthImageOptions& options)
-    : mesh_(mesh), bvh_(bvh), options_(options) {}
+    : mesh_(mesh),
+      bvh_(bvh),
+      options_(options),
+      projected_(mesh.vertices.size()),
+      stamp_(mesh.vertices.size(), 0) {}
 
 void DepthImageRenderer::RenderPair(const ViewFrame& frame, DepthImage* front, DepthImage* back) {
   const int size = options_.image_size;
@@ -27,28 +31,33 @@ void DepthImageRenderer::RenderPair(const ViewFrame& frame, DepthImage* front, D
   highest_.assign(static_cast<std::size_t>(size) * size, -std::numeric_limits<float>::infinity());
   lowest_.assign(static_cast<std::size_t>(size) * size, std::numeric_limits<float>::infinity());
 
-  // World-space box around the local cube |x|, |y|, |h| <= s.
-  Aabb box;
-  Vec3f half;
-  for (int a = 0; a < 3; ++a) {
-    half[a] = static_cast<float>(s * (std::abs(right[a]) + std::abs(up[a]) + std::abs(normal[a])));
-  }
-  box.min = Vec3f(frame.point) - half;
-  box.max = Vec3f(frame.point) + half;
+  // The local cube |x|, |y|, |h| <= s.
+  const OrientedBox cube{frame.point, {right, up, normal}, {s, s, s}};
   candidates_.clear();
-  bvh_.Query(box, &candidates_);
+  bvh_.Query(cube, &candidates_);
 
   // Pixel coordinates: pixel centre (col, row) at px = col, py = row.
   const double to_pixel = size / (2 * s);
+  if (++current_stamp_ == 0) {  // wrapped: reset the cache marks
+    std::fill(stamp_.begin(), stamp_.end(), 0);
+    current_stamp_ = 1;
+  }
   for (const uint32_t t : candidates_) {
     double px[3], py[3], h[3];
     bool all_above = true, all_below = true;
     for (int k = 0; k < 3; ++k) {
-      const Vec3d d = Vec3d(mesh_.vertices[mesh_.triangles[t][k]]) - frame.point;
-      const double x = Dot(d, right), y = Dot(d, up);
-      h[k] = Dot(d, normal);
-      px[k] = (x + s) * to_pixel - 0.5;
-      py[k] = (s - y) * to_pixel - 0.5;
+      const uint32_t v = mesh_.triangles[t][k];
+      Projected& proj = projected_[v];
+      if (stamp_[v] != current_stamp_) {
+        stamp_[v] = current_stamp_;
+        const Vec3d d = Vec3d(mesh_.vertices[v]) - frame.point;
+        proj.px = (Dot(d, right) + s) * to_pixel - 0.5;
+        proj.py = (s - Dot(d, up)) * to_pixel - 0.5;
+        proj.h = Dot(d, normal);
+      }
+      px[k] = proj.px;
+      py[k] = proj.py;
+      h[k] = proj.h;
       all_above = all_above && h[k] > s;
       all_below = all_below && h[k] < -s;
     }

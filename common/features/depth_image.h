@@ -80,6 +80,14 @@ class DepthImageRenderer {
   DepthImageOptions options_;
   std::vector<uint32_t> candidates_;
   std::vector<float> highest_, lowest_;
+  // Per-vertex projection cache: a vertex shared by several candidate
+  // triangles is projected once per view (stamp_ marks the current view).
+  struct Projected {
+    double px, py, h;
+  };
+  std::vector<Projected> projected_;
+  std::vector<uint32_t> stamp_;
+  uint32_t current_stamp_ = 0;
 };
 
 // LD-SIFT's post-processing, in place: empty pixels take the largest depth in

@@ -1,0 +1,169 @@
+#include "common/bof/codebook.h"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "common/base/status_macros.h"
+
+namespace meshseek {
+namespace {
+
+constexpr char kMagic[4] = {'M', 'S', 'C', 'B'};
+constexpr uint32_t kVersion = 1;
+constexpr std::size_t kHeaderBytes = 4 + 4 + 8 + 8;
+constexpr std::size_t kChecksumBytes = 8;
+
+uint64_t Fnv1a64(absl::string_view bytes) {
+  uint64_t hash = 14695981039346656037ull;
+  for (unsigned char b : bytes) {
+    hash ^= b;
+    hash *= 1099511628211ull;
+  }
+  return hash;
+}
+
+void PutLittleEndian(uint64_t value, int bytes, std::string* out) {
+  for (int i = 0; i < bytes; ++i) out->push_back(static_cast<char>((value >> (8 * i)) & 0xff));
+}
+
+uint64_t GetLittleEndian(const char* p, int bytes) {
+  uint64_t value = 0;
+  for (int i = 0; i < bytes; ++i) {
+    value |= static_cast<uint64_t>(static_cast<unsigned char>(p[i])) << (8 * i);
+  }
+  return value;
+}
+
+absl::Status CheckCentroids(const std::vector<float>& centroids, std::size_t dim) {
+  for (std::size_t i = 0; i < centroids.size(); ++i) {
+    if (!std::isfinite(centroids[i])) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "codebook: centroid ", i / dim, ", coordinate ", i % dim, " is ", centroids[i]));
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+Codebook::Codebook(std::vector<float> centroids, std::size_t size, std::size_t dim)
+    : centroids_(std::move(centroids)), index_(centroids_.data(), size, dim) {}
+
+absl::StatusOr<Codebook> Codebook::Train(const uint8_t* descriptors,
+                                         std::size_t count,
+                                         std::size_t dim,
+                                         const KMeansOptions& options,
+                                         KMeansReport* report) {
+  MESHSEEK_ASSIGN_OR_RETURN(std::vector<float> centroids,
+                            TrainKMeans(descriptors, count, dim, options, report));
+  return Codebook(std::move(centroids), static_cast<std::size_t>(options.num_centroids), dim);
+}
+
+absl::StatusOr<Codebook> Codebook::FromCentroids(std::vector<float> centroids, std::size_t dim) {
+  if (dim == 0) return absl::InvalidArgumentError("codebook: dim must be >= 1, got 0");
+  if (centroids.empty() || centroids.size() % dim != 0) {
+    return absl::InvalidArgumentError(absl::StrCat("codebook: got ",
+                                                   centroids.size(),
+                                                   " centroid values, not a positive multiple "
+                                                   "of dim ",
+                                                   dim));
+  }
+  const std::size_t size = centroids.size() / dim;
+  if (size > std::numeric_limits<uint32_t>::max()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("codebook: ", size, " words (at most 2^32 - 1)"));
+  }
+  MESHSEEK_RETURN_IF_ERROR(CheckCentroids(centroids, dim));
+  return Codebook(std::move(centroids), size, dim);
+}
+
+absl::StatusOr<std::vector<uint32_t>> Codebook::NearestCentroids(const uint8_t* descriptors,
+                                                                 std::size_t count) const {
+  if (descriptors == nullptr && count > 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("codebook: descriptors is null with count ", count));
+  }
+  std::vector<uint32_t> labels(count);
+  index_.Search(descriptors, count, /*num_threads=*/1, labels.data(), nullptr);
+  return labels;
+}
+
+absl::StatusOr<std::vector<float>> Codebook::Encode(const uint8_t* descriptors,
+                                                    std::size_t count) const {
+  if (count == 0) {
+    return absl::InvalidArgumentError(
+        "codebook: cannot encode an empty descriptor set (0 descriptors)");
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<uint32_t> labels,
+                            NearestCentroids(descriptors, count));
+  std::vector<std::size_t> counts(size(), 0);
+  for (uint32_t label : labels) ++counts[label];
+  std::vector<float> histogram(size());
+  for (std::size_t w = 0; w < size(); ++w) {
+    histogram[w] = static_cast<float>(static_cast<double>(counts[w]) / static_cast<double>(count));
+  }
+  return histogram;
+}
+
+std::string Codebook::Serialize() const {
+  std::string out(kMagic, sizeof(kMagic));
+  out.reserve(kHeaderBytes + centroids_.size() * 4 + kChecksumBytes);
+  PutLittleEndian(kVersion, 4, &out);
+  PutLittleEndian(size(), 8, &out);
+  PutLittleEndian(dim(), 8, &out);
+  for (float v : centroids_) {
+    uint32_t bits;
+    std::memcpy(&bits, &v, sizeof(bits));
+    PutLittleEndian(bits, 4, &out);
+  }
+  PutLittleEndian(Fnv1a64(out), 8, &out);
+  return out;
+}
+
+absl::StatusOr<Codebook> Codebook::Deserialize(absl::string_view bytes) {
+  if (bytes.size() < kHeaderBytes + kChecksumBytes) {
+    return absl::InvalidArgumentError(absl::StrCat("codebook: got ",
+                                                   bytes.size(),
+                                                   " bytes, shorter than the ",
+                                                   kHeaderBytes + kChecksumBytes,
+                                                   "-byte header and checksum"));
+  }
+  if (std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
+    return absl::InvalidArgumentError("codebook: bad magic (expected \"MSCB\")");
+  }
+  const uint64_t version = GetLittleEndian(bytes.data() + 4, 4);
+  if (version != kVersion) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "codebook: unsupported version ", version, " (this build reads ", kVersion, ")"));
+  }
+  const uint64_t size = GetLittleEndian(bytes.data() + 8, 8);
+  const uint64_t dim = GetLittleEndian(bytes.data() + 16, 8);
+  // Both factors are bounded before multiplying, so the byte count cannot overflow.
+  const uint64_t max_values = (bytes.size() - kHeaderBytes - kChecksumBytes) / 4;
+  if (size == 0 || dim == 0 || size > max_values || dim > max_values / size ||
+      kHeaderBytes + size * dim * 4 + kChecksumBytes != bytes.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("codebook: header says ",
+                                                   size,
+                                                   " words x ",
+                                                   dim,
+                                                   " dims, inconsistent with ",
+                                                   bytes.size(),
+                                                   " bytes"));
+  }
+  const std::size_t payload = bytes.size() - kChecksumBytes;
+  if (Fnv1a64(bytes.substr(0, payload)) != GetLittleEndian(bytes.data() + payload, 8)) {
+    return absl::InvalidArgumentError("codebook: checksum mismatch (corrupt data)");
+  }
+  std::vector<float> centroids(size * dim);
+  for (std::size_t i = 0; i < centroids.size(); ++i) {
+    const uint32_t bits =
+        static_cast<uint32_t>(GetLittleEndian(bytes.data() + kHeaderBytes + 4 * i, 4));
+    std::memcpy(&centroids[i], &bits, sizeof(bits));
+  }
+  return FromCentroids(std::move(centroids), dim);
+}
+
+}  // namespace meshseek

@@ -1,0 +1,47 @@
+// One entry point for every local-feature method of the paper's table, so the
+// pipeline, the CLI and (later) the extract service select a method by name
+// and never depend on which one it is.
+//
+// Methods: "dld" (DLD-SIFT, dense; dld_sift.h). LD-SIFT ("ld") and RLD-SIFT
+// ("rld") join here behind the same signature.
+#ifndef MESHSEEK_COMMON_FEATURES_LOCAL_FEATURE_EXTRACTOR_H_
+#define MESHSEEK_COMMON_FEATURES_LOCAL_FEATURE_EXTRACTOR_H_
+
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "common/base/json.h"
+#include "common/features/dld_sift.h"
+#include "common/features/local_features.h"
+#include "common/geometry/mesh.h"
+
+namespace meshseek {
+
+enum class FeatureMethod { kDldSift };
+
+// "dld" -> kDldSift. InvalidArgument listing the known names otherwise.
+absl::StatusOr<FeatureMethod> ParseFeatureMethod(absl::string_view name);
+const char* FeatureMethodName(FeatureMethod method);
+
+struct ExtractorOptions {
+  /// Which method extracts the features.
+  FeatureMethod method = FeatureMethod::kDldSift;
+  /// Parameters of DLD-SIFT (used when method is kDldSift).
+  DldSiftOptions dld;
+
+  /// Validates the options of the selected method.
+  absl::Status Validate() const;
+  /// The method and its parameters, for reports (metrics.json).
+  Json ToJson() const;
+};
+
+// Extracts the local features of one mesh with the selected method, on the
+// calling thread.
+absl::StatusOr<LocalFeatures> ExtractLocalFeatures(const TriangleMesh& mesh,
+                                                   const ExtractorOptions& options);
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_COMMON_FEATURES_LOCAL_FEATURE_EXTRACTOR_H_

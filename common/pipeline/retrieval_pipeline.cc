@@ -1,0 +1,187 @@
+#include "common/pipeline/retrieval_pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <numeric>
+
+#include "absl/strings/str_cat.h"
+#include "common/base/file_io.h"
+#include "common/base/logging.h"
+#include "common/base/parallel.h"
+#include "common/base/progress.h"
+#include "common/base/status_macros.h"
+#include "common/eval/distance_matrix.h"
+#include "common/geometry/mesh_io.h"
+
+namespace meshseek {
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+RetrievalPipelineOptions::RetrievalPipelineOptions() { kmeans.num_centroids = 1000; }
+
+absl::Status RetrievalPipelineOptions::Validate() const {
+  MESHSEEK_RETURN_IF_ERROR(extractor.Validate());
+  MESHSEEK_RETURN_IF_ERROR(kmeans.Validate());
+  return kl.Validate();
+}
+
+Json RetrievalPipelineOptions::ToJson() const {
+  Json json = Json::MakeObject();
+  json.Set("features", extractor.ToJson());
+  Json& codebook = json.Set("codebook", Json::MakeObject());
+  codebook.Set("vocabulary_size_V", kmeans.num_centroids);
+  codebook.Set("kmeans_seed", static_cast<int64_t>(kmeans.seed));
+  codebook.Set("kmeans_max_iterations", kmeans.max_iterations);
+  codebook.Set("kmeans_max_points_per_centroid", kmeans.max_points_per_centroid);
+  Json& ranking = json.Set("ranking", Json::MakeObject());
+  ranking.Set("distance", "symmetric KL divergence");
+  ranking.Set("epsilon", kl.epsilon);
+  json.Set("threads", ResolveThreadCount(num_threads));
+  return json;
+}
+
+absl::StatusOr<std::vector<LocalFeatures>> ExtractCollection(
+    const std::vector<ManifestEntry>& models, const RetrievalPipelineOptions& options) {
+  MESHSEEK_RETURN_IF_ERROR(options.Validate());
+  std::vector<LocalFeatures> features(models.size());
+  std::vector<absl::Status> errors(models.size());
+  ProgressBar progress("extract", models.size(), options.show_progress);
+  ParallelFor(models.size(), options.num_threads, [&](std::size_t i) {
+    absl::StatusOr<TriangleMesh> mesh = ReadMesh(models[i].path);
+    if (mesh.ok()) {
+      absl::StatusOr<LocalFeatures> extracted = ExtractLocalFeatures(*mesh, options.extractor);
+      if (extracted.ok()) {
+        features[i] = *std::move(extracted);
+      } else {
+        errors[i] = extracted.status();
+      }
+    } else {
+      errors[i] = mesh.status();
+    }
+    progress.Advance();
+  });
+  progress.Finish();
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    if (errors[i].ok()) continue;
+    const std::size_t failed =
+        std::count_if(errors.begin(), errors.end(), [](const absl::Status& s) { return !s.ok(); });
+    return absl::Status(errors[i].code(),
+                        absl::StrCat("model '", models[i].id, "' (manifest line ", models[i].line,
+                                     "): ", errors[i].message(),
+                                     failed > 1 ? absl::StrCat(" [and ", failed - 1, " more failed models]")
+                                                : ""));
+  }
+  return features;
+}
+
+absl::StatusOr<Codebook> TrainCollectionCodebook(const std::vector<LocalFeatures>& features,
+                                                 const RetrievalPipelineOptions& options) {
+  std::size_t total = 0;
+  for (const LocalFeatures& f : features) total += f.size();
+  std::vector<uint8_t> descriptors;
+  descriptors.reserve(total * kSiftDimension);
+  for (const LocalFeatures& f : features) {
+    descriptors.insert(descriptors.end(), f.descriptors.begin(), f.descriptors.end());
+  }
+  KMeansOptions kmeans = options.kmeans;
+  kmeans.num_threads = options.num_threads;
+  return Codebook::Train(descriptors.data(), total, kSiftDimension, kmeans);
+}
+
+absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
+    const Codebook& codebook, const std::vector<LocalFeatures>& features,
+    const RetrievalPipelineOptions& options) {
+  std::vector<std::vector<float>> histograms(features.size());
+  std::vector<absl::Status> errors(features.size());
+  ParallelFor(features.size(), options.num_threads, [&](std::size_t i) {
+    auto histogram = codebook.Encode(features[i].descriptors.data(), features[i].size());
+    if (histogram.ok()) {
+      histograms[i] = *std::move(histogram);
+    } else {
+      errors[i] = histogram.status();
+    }
+  });
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    if (!errors[i].ok()) {
+      return absl::Status(errors[i].code(), absl::StrCat("model ", i, ": ", errors[i].message()));
+    }
+  }
+  return histograms;
+}
+
+absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<ManifestEntry>& models,
+                                                        const RetrievalPipelineOptions& options) {
+  MESHSEEK_RETURN_IF_ERROR(options.Validate());
+  if (models.empty()) return absl::InvalidArgumentError("the collection has no models");
+  const auto start = std::chrono::steady_clock::now();
+  CollectionEvaluation result;
+  result.models = models;
+
+  auto stage = std::chrono::steady_clock::now();
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<LocalFeatures> features,
+                            ExtractCollection(models, options));
+  result.timings.extract_seconds = SecondsSince(stage);
+  for (const LocalFeatures& f : features) result.features_per_model.push_back(f.size());
+
+  stage = std::chrono::steady_clock::now();
+  MESHSEEK_ASSIGN_OR_RETURN(const Codebook codebook, TrainCollectionCodebook(features, options));
+  result.codebook_size = codebook.size();
+  result.timings.codebook_seconds = SecondsSince(stage);
+
+  stage = std::chrono::steady_clock::now();
+  MESHSEEK_ASSIGN_OR_RETURN(const auto histograms, EncodeCollection(codebook, features, options));
+  result.timings.encode_seconds = SecondsSince(stage);
+
+  stage = std::chrono::steady_clock::now();
+  MESHSEEK_ASSIGN_OR_RETURN(result.distances,
+                            SymmetricKlDistanceMatrix(histograms, options.kl, options.num_threads));
+  result.timings.rank_seconds = SecondsSince(stage);
+
+  std::vector<std::string> labels;
+  labels.reserve(models.size());
+  for (const ManifestEntry& m : models) labels.push_back(m.label);
+  MESHSEEK_ASSIGN_OR_RETURN(result.metrics,
+                            EvaluateRetrieval(labels, result.distances, options.num_threads));
+  result.timings.total_seconds = SecondsSince(start);
+  return result;
+}
+
+absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
+                             const RetrievalPipelineOptions& options, const std::string& out_dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) {
+    return absl::PermissionDeniedError(
+        absl::StrCat(out_dir, ": cannot create folder (", ec.message(), ")"));
+  }
+  MESHSEEK_RETURN_IF_ERROR(WriteDistanceMatrix(out_dir + "/distances.bin", evaluation.distances,
+                                               evaluation.models.size()));
+  Json report = MetricsToJson(evaluation.metrics);
+  report.Set("models", static_cast<int64_t>(evaluation.models.size()));
+  report.Set("parameters", options.ToJson());
+  Json& counts = report.Set("local_features", Json::MakeObject());
+  const auto& per_model = evaluation.features_per_model;
+  if (!per_model.empty()) {
+    std::vector<std::size_t> sorted = per_model;
+    std::sort(sorted.begin(), sorted.end());
+    counts.Set("total", static_cast<int64_t>(std::accumulate(sorted.begin(), sorted.end(), std::size_t{0})));
+    counts.Set("min_per_model", static_cast<int64_t>(sorted.front()));
+    counts.Set("median_per_model", static_cast<int64_t>(sorted[sorted.size() / 2]));
+    counts.Set("max_per_model", static_cast<int64_t>(sorted.back()));
+  }
+  Json& timings = report.Set("timings_seconds", Json::MakeObject());
+  timings.Set("extract", evaluation.timings.extract_seconds);
+  timings.Set("codebook", evaluation.timings.codebook_seconds);
+  timings.Set("encode", evaluation.timings.encode_seconds);
+  timings.Set("rank", evaluation.timings.rank_seconds);
+  timings.Set("total", evaluation.timings.total_seconds);
+  return WriteStringToFile(out_dir + "/metrics.json", report.Dump());
+}
+
+}  // namespace meshseek

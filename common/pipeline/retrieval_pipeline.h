@@ -1,0 +1,95 @@
+// The in-process retrieval pipeline: local features -> visual codebook ->
+// bag-of-features histograms -> symmetric-KL ranking -> metrics, for a labelled
+// collection, under the paper's protocol (DESIGN.md 3.3): every model is a
+// query against all others, and the codebook is learnt from the collection's
+// own local features.
+//
+// Each stage is a function of its own so that the distributed services run the
+// same code stage by stage; EvaluateCollection chains them for the CLI's
+// `eval` and the end-to-end tests.
+#ifndef MESHSEEK_COMMON_PIPELINE_RETRIEVAL_PIPELINE_H_
+#define MESHSEEK_COMMON_PIPELINE_RETRIEVAL_PIPELINE_H_
+
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "common/base/json.h"
+#include "common/bof/codebook.h"
+#include "common/bof/kl_divergence.h"
+#include "common/bof/kmeans.h"
+#include "common/eval/manifest.h"
+#include "common/eval/retrieval_metrics.h"
+#include "common/features/local_feature_extractor.h"
+
+namespace meshseek {
+
+struct RetrievalPipelineOptions {
+  RetrievalPipelineOptions();
+
+  /// Local features: the method and its parameters.
+  ExtractorOptions extractor;
+  /// Codebook learning; kmeans.num_centroids is the vocabulary size V. The
+  /// default V was chosen on the development sets (README, bench/).
+  KMeansOptions kmeans;
+  /// Ranking: symmetric KL divergence and its zero-bin rule.
+  KlDivergenceOptions kl;
+  /// Threads (<= 0: all cores). Extraction runs one model per thread; k-means,
+  /// encoding and ranking use them too. Results do not depend on it.
+  int num_threads = 0;
+  /// Progress bars with rate and time left on stderr.
+  bool show_progress = false;
+
+  absl::Status Validate() const;
+  /// Every parameter that affects the result, for metrics.json.
+  Json ToJson() const;
+};
+
+// Reads and extracts every model, in parallel across models. The first
+// failing model (in input order) fails the whole call with an error naming its
+// id, manifest line and the problem; a silently skipped model would change
+// every metric.
+absl::StatusOr<std::vector<LocalFeatures>> ExtractCollection(
+    const std::vector<ManifestEntry>& models, const RetrievalPipelineOptions& options);
+
+// Learns the codebook from all local descriptors of `features` (k-means
+// sub-samples them; see kmeans.h).
+absl::StatusOr<Codebook> TrainCollectionCodebook(const std::vector<LocalFeatures>& features,
+                                                 const RetrievalPipelineOptions& options);
+
+// One normalised histogram per model.
+absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
+    const Codebook& codebook, const std::vector<LocalFeatures>& features,
+    const RetrievalPipelineOptions& options);
+
+struct StageTimings {
+  double extract_seconds = 0;
+  double codebook_seconds = 0;
+  double encode_seconds = 0;
+  double rank_seconds = 0;
+  double total_seconds = 0;
+};
+
+struct CollectionEvaluation {
+  std::vector<ManifestEntry> models;           // input order = matrix order
+  std::vector<std::size_t> features_per_model;
+  std::size_t codebook_size = 0;
+  std::vector<float> distances;  // N x N row-major, entry i*N+j = D(model i, model j)
+  RetrievalMetrics metrics;
+  StageTimings timings;
+};
+
+// Runs every stage on a labelled collection and evaluates the ranking.
+absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<ManifestEntry>& models,
+                                                        const RetrievalPipelineOptions& options);
+
+// Writes DIR/distances.bin (PSB float32 matrix, manifest order) and
+// DIR/metrics.json (every metric, micro and macro, per class, the parameters,
+// feature counts and stage timings). Creates DIR if needed.
+absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
+                             const RetrievalPipelineOptions& options, const std::string& out_dir);
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_COMMON_PIPELINE_RETRIEVAL_PIPELINE_H_

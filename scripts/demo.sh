@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# The main job on the embedded default: builds meshseek, writes the built-in
+# synthetic benchmark and evaluates DLD-SIFT retrieval on it with
+# `meshseek eval`, printing the metrics table. Outputs go to ./out/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+./scripts/build.sh
+BIN=${MESHSEEK_BUILD_DIR:-build}/cli/meshseek
+"$BIN" synth --out out/synthetic
+"$BIN" eval --manifest out/synthetic/manifest.csv --method dld --out out/synthetic-eval

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs exactly the Debian 12 packages meshseek needs to build, test and
+# benchmark. Idempotent and quick when everything is already there; uses sudo
+# when not run as root.
+set -euo pipefail
+
+PACKAGES=(
+  g++ cmake ninja-build pkg-config ccache python3   # toolchain; python3 runs the reference evaluator
+  libabsl-dev                                        # Status, flags, strings
+  libopenmesh-dev                                    # mesh file readers
+  libopencv-dev                                      # SIFT descriptor (features2d)
+  libgtest-dev libgmock-dev libbenchmark-dev         # tests and benchmarks
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+echo "install-deps: installing ${missing[*]}"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
