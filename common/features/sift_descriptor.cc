@@ -7,9 +7,17 @@
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 
+#include "absl/strings/str_cat.h"
+
 namespace meshseek {
 
-absl::Status SiftDescriptorOptions::Validate() const { return absl::OkStatus(); }
+absl::Status SiftDescriptorOptions::Validate() const {
+  if (!(blur_sigma >= 0.5 && blur_sigma <= 5)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("SIFT blur_sigma must be in [0.5, 5] pixels, got ", blur_sigma));
+  }
+  return absl::OkStatus();
+}
 
 int Rotate180Index(int bin) {
   const int cell = bin / 8, orientation = bin % 8;
@@ -34,7 +42,7 @@ void NormalizeSiftDescriptor(float* bins, uint8_t* out) {
 
 struct DepthSiftDescriber::Impl {
   SiftDescriptorOptions options;
-  cv::Ptr<cv::SIFT> sift = cv::SIFT::create();
+  cv::Ptr<cv::SIFT> sift;
   cv::Mat gray;
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
@@ -43,6 +51,9 @@ struct DepthSiftDescriber::Impl {
 DepthSiftDescriber::DepthSiftDescriber(const SiftDescriptorOptions& options)
     : impl_(std::make_unique<Impl>()) {
   impl_->options = options;
+  // Only sigma matters when describing given keypoints; the others are
+  // OpenCV's detection defaults.
+  impl_->sift = cv::SIFT::create(0, 3, 0.04, 10, options.blur_sigma);
 }
 
 DepthSiftDescriber::~DepthSiftDescriber() = default;

@@ -38,6 +38,11 @@ enum class DepthToGray {
 struct SiftDescriptorOptions {
   /// Mapping from depth to grey level.
   DepthToGray depth_to_gray = DepthToGray::kFixedRange;
+  /// Gaussian blur sigma of the image before gradients, in pixels (cv::SIFT's
+  /// `sigma`, which assumes the input already carries 0.5 of blur: 0.5 means
+  /// no extra blur, as in VLFeat's raw descriptor that LD-SIFT's authors used;
+  /// 1.6 is Lowe's and OpenCV's default).
+  double blur_sigma = 1.6;
   /// Add the 180-degree-turned descriptor (LD-SIFT's cure for the sign
   /// ambiguity of the PCA up axis). Off only for experiments.
   bool symmetrize_180 = true;

@@ -1,0 +1,77 @@
+#include "common/pipeline/retrieval_pipeline.h"
+
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+#include "common/geometry/test_meshes.h"
+#include "common/synth/synthetic_benchmark.h"
+
+namespace meshseek {
+namespace {
+
+TEST(RetrievalPipelineOptionsTest, DefaultsArePinnedAndValid) {
+  const RetrievalPipelineOptions options;
+  EXPECT_TRUE(options.Validate().ok());
+  EXPECT_EQ(options.extractor.method, FeatureMethod::kDldSift);
+  EXPECT_EQ(options.kmeans.num_centroids, 1000);
+  EXPECT_EQ(options.kl.epsilon, 1e-6);
+  const std::string json = options.ToJson().Dump();
+  EXPECT_NE(json.find("\"vocabulary_size_V\": 1000"), std::string::npos) << json;
+}
+
+// A model and a rotated, scaled and moved copy of it get nearly the same
+// bag-of-features histogram: their KL distance is under 5 % of the distance
+// from the model to the nearest model of another class, and under 15 % of the
+// nearest model of its own class.
+TEST(RetrievalPipelineTest, HistogramDistancesAreInvariantToSimilarityTransforms) {
+  SyntheticBenchmarkOptions synth;
+  synth.models_per_class = 2;
+  auto models = MakeSyntheticModels(synth);
+  ASSERT_TRUE(models.ok()) << models.status();
+  ExtractorOptions extractor;
+  extractor.dld.num_points = 256;
+
+  std::vector<LocalFeatures> features;
+  for (const SyntheticModel& m : *models) {
+    auto f = ExtractLocalFeatures(m.mesh, extractor);
+    ASSERT_TRUE(f.ok()) << f.status();
+    features.push_back(*std::move(f));
+  }
+  TriangleMesh moved = (*models)[0].mesh;
+  TransformMesh(testing_meshes::AxisAngle(Vec3d(2, -1, 0.5), 2.7), 0.37, Vec3d(9, 1, -4), &moved);
+  auto moved_features = ExtractLocalFeatures(moved, extractor);
+  ASSERT_TRUE(moved_features.ok());
+
+  RetrievalPipelineOptions options;
+  options.kmeans.num_centroids = 64;
+  auto codebook = TrainCollectionCodebook(features, options);
+  ASSERT_TRUE(codebook.ok()) << codebook.status();
+  features.push_back(*moved_features);
+  auto histograms = EncodeCollection(*codebook, features, options);
+  ASSERT_TRUE(histograms.ok());
+  auto distances = SymmetricKlDistanceMatrix(*histograms, options.kl, 1);
+  ASSERT_TRUE(distances.ok());
+  const std::size_t n = histograms->size(), copy = n - 1;
+  double same_class = 1e30, other_class = 1e30;
+  for (std::size_t j = 1; j + 1 < n; ++j) {
+    const double d = (*distances)[j];
+    if ((*models)[j].label == (*models)[0].label) {
+      same_class = std::min(same_class, d);
+    } else {
+      other_class = std::min(other_class, d);
+    }
+  }
+  const double to_copy = (*distances)[copy];
+  EXPECT_LT(to_copy, 0.05 * other_class) << "copy " << to_copy << ", other class " << other_class;
+  EXPECT_LT(to_copy, 0.15 * same_class) << "copy " << to_copy << ", same class " << same_class;
+}
+
+TEST(RetrievalPipelineTest, EmptyCollectionIsAnError) {
+  auto result = EvaluateCollection({}, RetrievalPipelineOptions());
+  ASSERT_FALSE(result.ok());
+  EXPECT_NE(result.status().message().find("no models"), absl::string_view::npos);
+}
+
+}  // namespace
+}  // namespace meshseek

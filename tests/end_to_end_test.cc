@@ -1,0 +1,157 @@
+// End to end on the built-in synthetic benchmark: the in-process pipeline, the
+// `meshseek` CLI as a user runs it, and the independent evaluator.
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "common/base/file_io.h"
+#include "common/eval/distance_matrix.h"
+#include "common/pipeline/retrieval_pipeline.h"
+#include "common/synth/synthetic_benchmark.h"
+
+namespace meshseek {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Small but real settings: every class of the benchmark, fewer points and
+// words than the defaults so the suite stays quick.
+RetrievalPipelineOptions SmallOptions() {
+  RetrievalPipelineOptions options;
+  options.extractor.dld.num_points = 256;
+  options.kmeans.num_centroids = 150;
+  options.num_threads = 2;
+  return options;
+}
+
+class EndToEndTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(::testing::TempDir() + "/meshseek_e2e");
+    std::filesystem::remove_all(*dir_);
+    ASSERT_TRUE(GenerateSyntheticBenchmark(SyntheticBenchmarkOptions(), *dir_ + "/bench").ok());
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static std::string* dir_;
+};
+std::string* EndToEndTest::dir_ = nullptr;
+
+// Runs a shell command, returning its exit code and combined output.
+int RunCommand(const std::string& command, std::string* output) {
+  const std::string full = command + " 2>&1";
+  FILE* pipe = popen(full.c_str(), "r");
+  if (pipe == nullptr) return -1;
+  char buffer[4096];
+  std::size_t n;
+  output->clear();
+  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) output->append(buffer, n);
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST_F(EndToEndTest, PipelineRanksSyntheticClassesWellAboveChance) {
+  auto models = ReadManifest(*dir_ + "/bench/manifest.csv");
+  ASSERT_TRUE(models.ok()) << models.status();
+  ASSERT_EQ(models->size(), 72u);
+  auto evaluation = EvaluateCollection(*models, SmallOptions());
+  ASSERT_TRUE(evaluation.ok()) << evaluation.status();
+  // Chance first tier is 7/71 (10 %). The shapes are built to be told apart by
+  // local surface shape, with soups, several components and sparse and dense
+  // tessellations in every class.
+  EXPECT_GT(evaluation->metrics.micro.rp_excl, 0.6);
+  EXPECT_GT(evaluation->metrics.micro.nn, 0.8);
+  EXPECT_EQ(evaluation->metrics.queries, 72u);
+  for (std::size_t n : evaluation->features_per_model) EXPECT_GT(n, 400u);
+
+  // The same run twice gives the same matrix: extraction, k-means and ranking
+  // are deterministic whatever the thread count.
+  RetrievalPipelineOptions one_thread = SmallOptions();
+  one_thread.num_threads = 1;
+  auto again = EvaluateCollection(*models, one_thread);
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->distances, evaluation->distances);
+}
+
+TEST_F(EndToEndTest, CliEvalWritesMatrixAndMetricsThatTheReferenceEvaluatorAgreesWith) {
+  const std::string out = *dir_ + "/eval";
+  std::string output;
+  const int code = RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest " + *dir_ +
+                           "/bench/manifest.csv --method dld --points 256 --vocabulary 150 --out " + out,
+                       &output);
+  ASSERT_EQ(code, 0) << output;
+  EXPECT_THAT(output, HasSubstr("RP_excl"));
+  EXPECT_THAT(output, HasSubstr("micro"));
+  auto matrix = ReadDistanceMatrix(out + "/distances.bin", 72);
+  ASSERT_TRUE(matrix.ok()) << matrix.status();
+  for (std::size_t i = 0; i < 72; ++i) EXPECT_EQ((*matrix)[i * 72 + i], 0.0f);
+  auto json = ReadFileToString(out + "/metrics.json");
+  ASSERT_TRUE(json.ok());
+  EXPECT_THAT(*json, HasSubstr("\"RP_excl\""));
+  EXPECT_THAT(*json, HasSubstr("\"scale_E\""));
+  EXPECT_THAT(*json, HasSubstr("\"vocabulary_size_V\": 150"));
+
+  const std::string evaluator =
+      std::string(std::getenv("MESHSEEK_SOURCE_DIR")) + "/../shared/tools/psb_eval.py";
+  if (!std::filesystem::exists(evaluator)) GTEST_SKIP() << evaluator << " not present";
+  std::string reference;
+  ASSERT_EQ(RunCommand("python3 " + evaluator + " " + *dir_ + "/bench/manifest.csv " + out + "/distances.bin",
+                &reference),
+            0)
+      << reference;
+  // psb_eval.py prints the same table as meshseek (one decimal, same layout).
+  std::istringstream lines(reference);
+  std::string line;
+  int matched = 0;
+  while (std::getline(lines, line)) {
+    if (line.find("micro") != std::string::npos || line.find("macro") != std::string::npos) {
+      EXPECT_THAT(output, HasSubstr(line));
+      ++matched;
+    }
+  }
+  EXPECT_EQ(matched, 2);
+}
+
+TEST_F(EndToEndTest, CliNamesTheModelAndLineOfABadMeshAndFailsCleanly) {
+  const std::string dir = *dir_ + "/bad";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/ok.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  std::ofstream(dir + "/broken.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
+  std::ofstream(dir + "/manifest.csv") << "id,class,path\na,x,ok.off\nb,x,broken.off\nc,x,ok.off\n";
+  std::string output;
+  const int code = RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --progress=false --manifest " + dir +
+                           "/manifest.csv --out " + dir + "/out",
+                       &output);
+  EXPECT_NE(code, 0);
+  EXPECT_THAT(output, HasSubstr("model 'b' (manifest line 3)"));
+  EXPECT_THAT(output, HasSubstr("broken.off: face 0 (0-based) references vertex 7"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out/distances.bin"));
+}
+
+TEST_F(EndToEndTest, CliRejectsBadFlagsWithAClearMessage) {
+  std::string output;
+  EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --out /tmp/x", &output), 2);
+  EXPECT_THAT(output, HasSubstr("eval needs --manifest FILE"));
+  EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest " + *dir_ +
+                    "/bench/manifest.csv --out /tmp/x --method sift3d",
+                &output),
+            2);
+  EXPECT_THAT(output, HasSubstr("unknown feature method 'sift3d'"));
+  EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest " + *dir_ +
+                    "/bench/manifest.csv --out /tmp/x --scale -1",
+                &output),
+            2);
+  EXPECT_THAT(output, HasSubstr("scale E must be in (0, 2], got -1"));
+  EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " frobnicate", &output), 2);
+  EXPECT_THAT(output, HasSubstr("unknown command 'frobnicate'"));
+  EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest /nonexistent.csv --out /tmp/x", &output), 1);
+  EXPECT_THAT(output, HasSubstr("/nonexistent.csv"));
+}
+
+}  // namespace
+}  // namespace meshseek
