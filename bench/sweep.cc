@@ -28,6 +28,7 @@ ABSL_FLAG(std::string, depth_to_gray, "fixed", "fixed | stretch");
 ABSL_FLAG(int, points, meshseek::DldSiftOptions().num_points, "feature points per model");
 ABSL_FLAG(int, frame_samples, meshseek::DldSiftOptions().frame_samples_per_support,
           "dense samples per support disc for the PCA frame");
+ABSL_FLAG(std::string, orientation, "up", "up | dominant");
 ABSL_FLAG(double, blur_sigma, meshseek::SiftDescriptorOptions().blur_sigma, "SIFT blur sigma");
 ABSL_FLAG(std::string, epsilons, "", "comma-separated KL epsilons (default: the shipped one)");
 ABSL_FLAG(int, threads, 0, "threads (0: all cores)");
@@ -69,6 +70,9 @@ int main(int argc, char** argv) {
   options.extractor.dld.descriptor.depth_to_gray =
       absl::GetFlag(FLAGS_depth_to_gray) == "stretch" ? DepthToGray::kStretch : DepthToGray::kFixedRange;
   options.extractor.dld.descriptor.blur_sigma = absl::GetFlag(FLAGS_blur_sigma);
+  options.extractor.dld.descriptor.orientation = absl::GetFlag(FLAGS_orientation) == "dominant"
+                                                     ? ImageOrientation::kDominant
+                                                     : ImageOrientation::kUpAxis;
   std::vector<double> epsilons = ParseList<double>(absl::GetFlag(FLAGS_epsilons));
   if (epsilons.empty()) epsilons.push_back(options.kl.epsilon);
   std::vector<std::string> labels;

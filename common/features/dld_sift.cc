@@ -59,7 +59,6 @@ absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh, const Dld
   features.descriptors.reserve(2 * centres.size() * kSiftDimension);
   std::vector<uint32_t> support;
   DepthImage front, back;
-  uint8_t descriptor[kSiftDimension];
   for (std::size_t i = 0; i < centres.size(); ++i) {
     const Vec3f& p = centres.positions[i];
     support.clear();
@@ -70,10 +69,12 @@ absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh, const Dld
     renderer.RenderPair(frame, &front, options.two_views ? &back : nullptr);
     for (int view = 0; view < (options.two_views ? 2 : 1); ++view) {
       DepthImage& image = view == 0 ? front : back;
-      if (!FinishDepthImage(&image) || !describer.Describe(image, descriptor)) continue;
+      if (!FinishDepthImage(&image)) continue;
+      const int described = describer.Describe(image, &features.descriptors);
       const Vec3f forward(view == 0 ? -frame.normal : frame.normal);
-      features.keypoints.push_back({p, forward, Vec3f(frame.up), static_cast<float>(s), 0});
-      features.descriptors.insert(features.descriptors.end(), descriptor, descriptor + kSiftDimension);
+      for (int k = 0; k < described; ++k) {
+        features.keypoints.push_back({p, forward, Vec3f(frame.up), static_cast<float>(s), 0});
+      }
     }
   }
   if (features.keypoints.empty()) {

@@ -37,6 +37,9 @@ Json ExtractorOptions::ToJson() const {
       json.Set("image_size", dld.depth_image.image_size);
       json.Set("depth_to_gray",
                dld.descriptor.depth_to_gray == DepthToGray::kFixedRange ? "fixed_range" : "stretch");
+      json.Set("orientation", dld.descriptor.orientation == ImageOrientation::kUpAxis
+                                  ? "up_axis_180_sum"
+                                  : "dominant_gradient");
       json.Set("sift_blur_sigma", dld.descriptor.blur_sigma);
       json.Set("symmetrize_180", dld.descriptor.symmetrize_180);
       break;

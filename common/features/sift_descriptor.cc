@@ -58,7 +58,45 @@ DepthSiftDescriber::DepthSiftDescriber(const SiftDescriptorOptions& options)
 
 DepthSiftDescriber::~DepthSiftDescriber() = default;
 
-bool DepthSiftDescriber::Describe(const DepthImage& image, uint8_t* out) {
+std::vector<float> DominantOrientations(const DepthImage& image, float peak_ratio) {
+  constexpr int kBins = 36;
+  const int size = image.size;
+  const float centre = (size - 1) / 2.0f;
+  const float sigma = 0.4f * size;  // most of the image, centre first
+  float hist[kBins] = {};
+  for (int r = 1; r + 1 < size; ++r) {
+    for (int c = 1; c + 1 < size; ++c) {
+      const float dx = image.at(r, c + 1) - image.at(r, c - 1);
+      const float dy = image.at(r - 1, c) - image.at(r + 1, c);  // y up
+      const float magnitude = std::sqrt(dx * dx + dy * dy);
+      if (magnitude <= 0) continue;
+      const float d2 = (r - centre) * (r - centre) + (c - centre) * (c - centre);
+      float angle = std::atan2(dy, dx) * static_cast<float>(180.0 / M_PI);
+      if (angle < 0) angle += 360.0f;
+      const int bin = static_cast<int>(angle * kBins / 360.0f) % kBins;
+      hist[bin] += magnitude * std::exp(-d2 / (2 * sigma * sigma));
+    }
+  }
+  float smooth[kBins];
+  for (int b = 0; b < kBins; ++b) {  // [1 4 6 4 1] / 16, circular, as OpenCV's SIFT
+    auto h = [&](int k) { return hist[(k + kBins) % kBins]; };
+    smooth[b] = (h(b - 2) + h(b + 2)) / 16 + (h(b - 1) + h(b + 1)) * 4 / 16 + h(b) * 6 / 16;
+  }
+  const float highest = *std::max_element(smooth, smooth + kBins);
+  std::vector<float> angles;
+  if (!(highest > 0)) return angles;
+  for (int b = 0; b < kBins; ++b) {
+    const float left = smooth[(b + kBins - 1) % kBins], right = smooth[(b + 1) % kBins];
+    if (smooth[b] > left && smooth[b] > right && smooth[b] >= peak_ratio * highest) {
+      const float offset = 0.5f * (left - right) / (left - 2 * smooth[b] + right);
+      float angle = (b + 0.5f + offset) * 360.0f / kBins;
+      angles.push_back(std::fmod(angle + 360.0f, 360.0f));
+    }
+  }
+  return angles;
+}
+
+int DepthSiftDescriber::Describe(const DepthImage& image, std::vector<uint8_t>* out) {
   const int size = image.size;
   cv::Mat& gray = impl_->gray;
   gray.create(size, size, CV_8U);
@@ -77,16 +115,32 @@ bool DepthSiftDescriber::Describe(const DepthImage& image, uint8_t* out) {
     }
   }
   const float centre = static_cast<float>(size / 2);
-  impl_->keypoints.assign(1, cv::KeyPoint(centre, centre, size / 6.0f, 0.0f));
-  impl_->sift->compute(gray, impl_->keypoints, impl_->descriptors);
-  if (impl_->descriptors.rows != 1 || impl_->descriptors.cols != kSiftDimension) return false;
-  const float* raw = impl_->descriptors.ptr<float>(0);
-  float bins[kSiftDimension];
-  for (int k = 0; k < kSiftDimension; ++k) {
-    bins[k] = raw[k] + (impl_->options.symmetrize_180 ? raw[Rotate180Index(k)] : 0.0f);
+  const float keypoint_size = size / 6.0f;
+  impl_->keypoints.clear();
+  const bool up_axis = impl_->options.orientation == ImageOrientation::kUpAxis;
+  if (up_axis) {
+    impl_->keypoints.emplace_back(centre, centre, keypoint_size, 0.0f);
+  } else {
+    // OpenCV's keypoint angle is clockwise (image y points down): 360 - theta.
+    for (const float theta : DominantOrientations(image)) {
+      const float angle = 360.0f - theta;
+      impl_->keypoints.emplace_back(centre, centre, keypoint_size, angle >= 360.0f ? 0.0f : angle);
+    }
+    // A flat image has no orientation; describe it upright (all zeros anyway).
+    if (impl_->keypoints.empty()) impl_->keypoints.emplace_back(centre, centre, keypoint_size, 0.0f);
   }
-  NormalizeSiftDescriptor(bins, out);
-  return true;
+  impl_->sift->compute(gray, impl_->keypoints, impl_->descriptors);
+  if (impl_->descriptors.cols != kSiftDimension) return 0;
+  float bins[kSiftDimension];
+  for (int row = 0; row < impl_->descriptors.rows; ++row) {
+    const float* raw = impl_->descriptors.ptr<float>(row);
+    const bool sum_turned = up_axis && impl_->options.symmetrize_180;
+    for (int k = 0; k < kSiftDimension; ++k) bins[k] = raw[k] + (sum_turned ? raw[Rotate180Index(k)] : 0.0f);
+    const std::size_t at = out->size();
+    out->resize(at + kSiftDimension);
+    NormalizeSiftDescriptor(bins, out->data() + at);
+  }
+  return impl_->descriptors.rows;
 }
 
 }  // namespace meshseek

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "common/features/depth_image.h"
@@ -35,7 +36,21 @@ enum class DepthToGray {
   kStretch,
 };
 
+// How the descriptor's rotation about the view axis is fixed.
+enum class ImageOrientation {
+  // The frame's up axis is up in the image, and the descriptor of the image
+  // turned by 180 degrees is added (LD-SIFT): one descriptor per image.
+  kUpAxis,
+  // Lowe's dominant gradient orientations: one descriptor per peak of the
+  // image's orientation histogram within 80 % of the highest ("one or more
+  // SIFT features per image", Ohishi & Ohbuchi). Independent of the frame's
+  // up axis, which PCA leaves unstable on nearly isotropic patches.
+  kDominant,
+};
+
 struct SiftDescriptorOptions {
+  /// How rotation about the view axis is fixed.
+  ImageOrientation orientation = ImageOrientation::kUpAxis;
   /// Mapping from depth to grey level.
   DepthToGray depth_to_gray = DepthToGray::kFixedRange;
   /// Gaussian blur sigma of the image before gradients, in pixels (cv::SIFT's
@@ -43,12 +58,19 @@ struct SiftDescriptorOptions {
   /// no extra blur, as in VLFeat's raw descriptor that LD-SIFT's authors used;
   /// 1.6 is Lowe's and OpenCV's default).
   double blur_sigma = 1.6;
-  /// Add the 180-degree-turned descriptor (LD-SIFT's cure for the sign
-  /// ambiguity of the PCA up axis). Off only for experiments.
+  /// With kUpAxis: add the 180-degree-turned descriptor (LD-SIFT's cure for
+  /// the sign ambiguity of the PCA up axis). Off only for experiments.
   bool symmetrize_180 = true;
 
   absl::Status Validate() const;
 };
+
+// Lowe's dominant orientations of an image, in degrees counter-clockwise from
+// the image's +x axis (y up): peaks of a 36-bin histogram of gradient
+// orientations weighted by magnitude and a centred Gaussian, smoothed, with
+// every local peak within `peak_ratio` of the highest kept and refined by a
+// parabola. Empty for an image without gradient.
+std::vector<float> DominantOrientations(const DepthImage& image, float peak_ratio = 0.8f);
 
 // Turns float SIFT bins into SIFT's normalised byte form (in place on `bins`,
 // result in `out`).
@@ -65,9 +87,10 @@ class DepthSiftDescriber {
   DepthSiftDescriber(const DepthSiftDescriber&) = delete;
   DepthSiftDescriber& operator=(const DepthSiftDescriber&) = delete;
 
-  // Writes kSiftDimension bytes to `out` for a finished image
-  // (FinishDepthImage). Returns false if OpenCV produced no descriptor.
-  bool Describe(const DepthImage& image, uint8_t* out);
+  // Appends the descriptors of a finished image (FinishDepthImage) to `out`,
+  // kSiftDimension bytes each, and returns how many: one with kUpAxis, one or
+  // more with kDominant (none only if OpenCV produced nothing).
+  int Describe(const DepthImage& image, std::vector<uint8_t>* out);
 
  private:
   struct Impl;

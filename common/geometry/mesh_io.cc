@@ -20,6 +20,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "common/base/file_io.h"
 #include "common/base/status_macros.h"
 
 namespace meshseek {
@@ -133,32 +134,32 @@ bool IsBinaryFile(const std::string& head, MeshFormat format) {
 // "vertex", or a line of plain numbers as in OFF and PLY bodies) so the error
 // can name the line.
 absl::Status CheckAsciiNumbers(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
+  MESHSEEK_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
   std::size_t line_no = 0;
-  while (std::getline(in, line)) {
+  std::vector<absl::string_view> tokens;
+  for (absl::string_view line : absl::StrSplit(text, '\n')) {
     ++line_no;
-    const std::vector<absl::string_view> tokens =
-        absl::StrSplit(line, absl::ByAnyChar(" \t\r"), absl::SkipEmpty());
+    // Only a token with one of these letters can be non-finite ("nan",
+    // "inf", "1e999"); most lines have none and are skipped without parsing.
+    if (line.find_first_of("nNiIeE") == absl::string_view::npos) continue;
+    tokens = absl::StrSplit(line, absl::ByAnyChar(" \t\r"), absl::SkipEmpty());
     if (tokens.empty()) continue;
-    std::size_t first = 0;
-    if (tokens[0] == "v" || tokens[0] == "vertex") first = 1;
+    const std::size_t first = (tokens[0] == "v" || tokens[0] == "vertex") ? 1 : 0;
     bool all_numbers = first < tokens.size();
-    bool non_finite = false;
     absl::string_view bad;
     for (std::size_t k = first; k < tokens.size() && all_numbers; ++k) {
-      const std::string tok(tokens[k]);
+      const std::string token(tokens[k]);
       char* end = nullptr;
       errno = 0;
-      const double value = std::strtod(tok.c_str(), &end);
-      if (end == tok.c_str() || *end != '\0') {
+      const double value = std::strtod(token.c_str(), &end);
+      if (end == token.c_str() || *end != '\0') {
         all_numbers = false;
-      } else if (!std::isfinite(value) || (errno == ERANGE && std::abs(value) > 1)) {
-        non_finite = true;
-        if (bad.empty()) bad = tokens[k];
+      } else if (bad.empty() &&
+                 (!std::isfinite(value) || (errno == ERANGE && std::abs(value) > 1))) {
+        bad = tokens[k];
       }
     }
-    if (all_numbers && non_finite) {
+    if (all_numbers && !bad.empty()) {
       return absl::InvalidArgumentError(
           absl::StrCat("line ", line_no, ": non-finite coordinate '", bad, "'"));
     }
