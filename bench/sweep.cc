@@ -2,10 +2,12 @@
 // development sets (McGill articulated, PSB train) and for the E plot.
 //
 //   sweep --manifest FILE --scales 0.1,0.2,0.3 --vocabularies 500,1000,2000
-//         [--depth_to_gray fixed|stretch] [--points 1024] [--threads 0] [--csv OUT]
+//         [--epsilons 1e-6,1e-10] [--csv OUT] [--tag TEXT] [any pipeline flag of
+//         `meshseek eval`: --orientation, --frame_samples, --seed, ...]
 //
 // Extracts once per scale E and reuses the features for every vocabulary
-// size V; prints one row per (E, V) and appends it to --csv.
+// size V and KL epsilon; prints one row per (E, V, epsilon) and appends it to
+// --csv.
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -19,19 +21,13 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
+#include "cli/pipeline_flags.h"
 #include "common/pipeline/retrieval_pipeline.h"
 
 ABSL_FLAG(std::string, manifest, "", "CSV manifest id,class,path");
 ABSL_FLAG(std::string, scales, "0.25", "comma-separated DLD-SIFT scales E");
 ABSL_FLAG(std::string, vocabularies, "1000", "comma-separated codebook sizes V");
-ABSL_FLAG(std::string, depth_to_gray, "fixed", "fixed | stretch");
-ABSL_FLAG(int, points, meshseek::DldSiftOptions().num_points, "feature points per model");
-ABSL_FLAG(int, frame_samples, meshseek::DldSiftOptions().frame_samples_per_support,
-          "dense samples per support disc for the PCA frame");
-ABSL_FLAG(std::string, orientation, "up", "up | dominant");
-ABSL_FLAG(double, blur_sigma, meshseek::SiftDescriptorOptions().blur_sigma, "SIFT blur sigma");
 ABSL_FLAG(std::string, epsilons, "", "comma-separated KL epsilons (default: the shipped one)");
-ABSL_FLAG(int, threads, 0, "threads (0: all cores)");
 ABSL_FLAG(std::string, csv, "", "append result rows to this CSV file");
 ABSL_FLAG(std::string, tag, "", "free text copied into the CSV rows");
 
@@ -62,17 +58,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", models.status().ToString().c_str());
     return 1;
   }
-  RetrievalPipelineOptions options;
-  options.num_threads = absl::GetFlag(FLAGS_threads);
-  options.show_progress = true;
-  options.extractor.dld.num_points = absl::GetFlag(FLAGS_points);
-  options.extractor.dld.frame_samples_per_support = absl::GetFlag(FLAGS_frame_samples);
-  options.extractor.dld.descriptor.depth_to_gray =
-      absl::GetFlag(FLAGS_depth_to_gray) == "stretch" ? DepthToGray::kStretch : DepthToGray::kFixedRange;
-  options.extractor.dld.descriptor.blur_sigma = absl::GetFlag(FLAGS_blur_sigma);
-  options.extractor.dld.descriptor.orientation = absl::GetFlag(FLAGS_orientation) == "dominant"
-                                                     ? ImageOrientation::kDominant
-                                                     : ImageOrientation::kUpAxis;
+  auto parsed = cli::PipelineOptionsFromFlags();
+  if (!parsed.ok()) {
+    std::fprintf(stderr, "%s\n", parsed.status().ToString().c_str());
+    return 2;
+  }
+  RetrievalPipelineOptions options = *parsed;
   std::vector<double> epsilons = ParseList<double>(absl::GetFlag(FLAGS_epsilons));
   if (epsilons.empty()) epsilons.push_back(options.kl.epsilon);
   std::vector<std::string> labels;

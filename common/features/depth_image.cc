@@ -20,8 +20,7 @@ DepthImageRenderer::DepthImageRenderer(const TriangleMesh& mesh, const TriangleB
     : mesh_(mesh),
       bvh_(bvh),
       options_(options),
-      projected_(mesh.vertices.size()),
-      stamp_(mesh.vertices.size(), 0) {}
+      projected_(mesh.vertices.size()) {}
 
 void DepthImageRenderer::RenderPair(const ViewFrame& frame, DepthImage* front, DepthImage* back) {
   const int size = options_.image_size;
@@ -36,59 +35,64 @@ void DepthImageRenderer::RenderPair(const ViewFrame& frame, DepthImage* front, D
   candidates_.clear();
   bvh_.Query(cube, &candidates_);
 
-  // Pixel coordinates: pixel centre (col, row) at px = col, py = row.
+  // Pixel coordinates: pixel centre (col, row) at px = col, py = row. The
+  // projection is done in double (models may sit far from the origin), the
+  // per-pixel work in float (image-sized numbers).
   const double to_pixel = size / (2 * s);
   if (++current_stamp_ == 0) {  // wrapped: reset the cache marks
-    std::fill(stamp_.begin(), stamp_.end(), 0);
+    for (Projected& p : projected_) p.stamp = 0;
     current_stamp_ = 1;
   }
+  const float sf = static_cast<float>(s);
+  const float last = static_cast<float>(size - 1);
   for (const uint32_t t : candidates_) {
-    double px[3], py[3], h[3];
-    bool all_above = true, all_below = true;
+    const Projected* corner[3];
     for (int k = 0; k < 3; ++k) {
       const uint32_t v = mesh_.triangles[t][k];
       Projected& proj = projected_[v];
-      if (stamp_[v] != current_stamp_) {
-        stamp_[v] = current_stamp_;
+      if (proj.stamp != current_stamp_) {
+        proj.stamp = current_stamp_;
         const Vec3d d = Vec3d(mesh_.vertices[v]) - frame.point;
-        proj.px = (Dot(d, right) + s) * to_pixel - 0.5;
-        proj.py = (s - Dot(d, up)) * to_pixel - 0.5;
-        proj.h = Dot(d, normal);
+        proj.px = static_cast<float>((Dot(d, right) + s) * to_pixel - 0.5);
+        proj.py = static_cast<float>((s - Dot(d, up)) * to_pixel - 0.5);
+        proj.h = static_cast<float>(Dot(d, normal));
       }
-      px[k] = proj.px;
-      py[k] = proj.py;
-      h[k] = proj.h;
-      all_above = all_above && h[k] > s;
-      all_below = all_below && h[k] < -s;
+      corner[k] = &proj;
     }
-    if (all_above || all_below) continue;
-    const double area = (px[1] - px[0]) * (py[2] - py[0]) - (px[2] - px[0]) * (py[1] - py[0]);
-    if (std::abs(area) < 1e-12) continue;  // seen edge-on
-    const int c0 = std::max(0, static_cast<int>(std::ceil(std::min({px[0], px[1], px[2]}))));
-    const int c1 = std::min(size - 1, static_cast<int>(std::floor(std::max({px[0], px[1], px[2]}))));
-    const int r0 = std::max(0, static_cast<int>(std::ceil(std::min({py[0], py[1], py[2]}))));
-    const int r1 = std::min(size - 1, static_cast<int>(std::floor(std::max({py[0], py[1], py[2]}))));
-    if (c0 > c1 || r0 > r1) continue;
-    const double inv_area = 1.0 / area;
+    const Projected &a = *corner[0], &b = *corner[1], &c = *corner[2];
+    if ((a.h > sf && b.h > sf && c.h > sf) || (a.h < -sf && b.h < -sf && c.h < -sf)) continue;
+    // Pixel centres inside the triangle's bounding box; most triangles of a
+    // dense mesh cover none and stop here.
+    const float min_x = std::max(0.0f, std::ceil(std::min({a.px, b.px, c.px})));
+    const float max_x = std::min(last, std::floor(std::max({a.px, b.px, c.px})));
+    if (min_x > max_x) continue;
+    const float min_y = std::max(0.0f, std::ceil(std::min({a.py, b.py, c.py})));
+    const float max_y = std::min(last, std::floor(std::max({a.py, b.py, c.py})));
+    if (min_y > max_y) continue;
+    const float area = (b.px - a.px) * (c.py - a.py) - (c.px - a.px) * (b.py - a.py);
+    if (std::abs(area) < 1e-9f) continue;  // seen edge-on
+    const float inv_area = 1.0f / area;
+    const int c0 = static_cast<int>(min_x), c1 = static_cast<int>(max_x);
+    const int r0 = static_cast<int>(min_y), r1 = static_cast<int>(max_y);
     for (int row = r0; row <= r1; ++row) {
+      const float y = static_cast<float>(row);
       for (int col = c0; col <= c1; ++col) {
+        const float x = static_cast<float>(col);
         // Barycentric weights from edge functions; inclusive of edges.
-        const double w0 = ((px[1] - col) * (py[2] - row) - (px[2] - col) * (py[1] - row)) * inv_area;
-        const double w1 = ((px[2] - col) * (py[0] - row) - (px[0] - col) * (py[2] - row)) * inv_area;
-        const double w2 = 1.0 - w0 - w1;
-        constexpr double kEdgeEps = -1e-9;
+        const float w0 = ((b.px - x) * (c.py - y) - (c.px - x) * (b.py - y)) * inv_area;
+        const float w1 = ((c.px - x) * (a.py - y) - (a.px - x) * (c.py - y)) * inv_area;
+        const float w2 = 1.0f - w0 - w1;
+        constexpr float kEdgeEps = -1e-6f;
         if (w0 < kEdgeEps || w1 < kEdgeEps || w2 < kEdgeEps) continue;
-        const double height = w0 * h[0] + w1 * h[1] + w2 * h[2];
-        if (height > s || height < -s) continue;
+        const float height = w0 * a.h + w1 * b.h + w2 * c.h;
+        if (height > sf || height < -sf) continue;
         const std::size_t i = static_cast<std::size_t>(row) * size + col;
-        const float hf = static_cast<float>(height);
-        highest_[i] = std::max(highest_[i], hf);
-        lowest_[i] = std::min(lowest_[i], hf);
+        highest_[i] = std::max(highest_[i], height);
+        lowest_[i] = std::min(lowest_[i], height);
       }
     }
   }
 
-  const float sf = static_cast<float>(s);
   if (front != nullptr) {
     front->size = size;
     front->support_radius = sf;

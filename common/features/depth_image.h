@@ -83,10 +83,10 @@ class DepthImageRenderer {
   // Per-vertex projection cache: a vertex shared by several candidate
   // triangles is projected once per view (stamp_ marks the current view).
   struct Projected {
-    double px, py, h;
+    float px = 0, py = 0, h = 0;
+    uint32_t stamp = 0;
   };
   std::vector<Projected> projected_;
-  std::vector<uint32_t> stamp_;
   uint32_t current_stamp_ = 0;
 };
 

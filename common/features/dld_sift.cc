@@ -64,7 +64,10 @@ absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh, const Dld
     support.clear();
     grid.RadiusQuery(p, static_cast<float>(s), &support);
     if (support.size() < 3) continue;
-    const PrincipalAxes axes = ComputePrincipalAxes(dense.positions, &support);
+    const PrincipalAxes axes =
+        options.weighted_frame
+            ? ComputeWeightedPrincipalAxes(dense.positions, support, Vec3d(p), s)
+            : ComputePrincipalAxes(dense.positions, &support);
     const ViewFrame frame{Vec3d(p), axes.axes[0], axes.axes[2], s};
     renderer.RenderPair(frame, &front, options.two_views ? &back : nullptr);
     for (int view = 0; view < (options.two_views ? 2 : 1); ++view) {

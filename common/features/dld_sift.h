@@ -37,13 +37,17 @@ struct DldSiftOptions {
   /// E, the support radius relative to the minimum enclosing sphere:
   /// s = scale * D / 2. The paper's Fig. 6: articulated shapes (McGill) prefer
   /// small E, rigid ones (PSB) larger. Chosen by the sweep in bench/.
-  double scale = 0.25;
+  double scale = 0.2;
   /// Render the back view too (the paper's two views). One view only for
   /// experiments.
   bool two_views = true;
+  /// Weight the local PCA by (s - distance) about the feature point (SHOT's
+  /// repeatable local reference frame) instead of plain PCA about the
+  /// centroid of the support.
+  bool weighted_frame = true;
   /// Target number of dense samples in a flat disc of radius s for the local
   /// PCA frame; the dense sample count is this times area / (pi s^2).
-  int frame_samples_per_support = 128;
+  int frame_samples_per_support = 512;
   /// Lower and upper bounds on that dense sample count (time and memory guard
   /// for very small E or huge models).
   int min_frame_samples = 2048;

@@ -34,6 +34,7 @@ Json ExtractorOptions::ToJson() const {
       json.Set("support_radius", "E * D / 2 (D: minimum enclosing sphere diameter)");
       json.Set("two_views", dld.two_views);
       json.Set("frame_samples_per_support", dld.frame_samples_per_support);
+      json.Set("weighted_frame", dld.weighted_frame);
       json.Set("image_size", dld.depth_image.image_size);
       json.Set("depth_to_gray",
                dld.descriptor.depth_to_gray == DepthToGray::kFixedRange ? "fixed_range" : "stretch");

@@ -50,7 +50,7 @@ enum class ImageOrientation {
 
 struct SiftDescriptorOptions {
   /// How rotation about the view axis is fixed.
-  ImageOrientation orientation = ImageOrientation::kUpAxis;
+  ImageOrientation orientation = ImageOrientation::kDominant;
   /// Mapping from depth to grey level.
   DepthToGray depth_to_gray = DepthToGray::kFixedRange;
   /// Gaussian blur sigma of the image before gradients, in pixels (cv::SIFT's

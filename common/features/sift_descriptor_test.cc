@@ -48,6 +48,12 @@ std::vector<uint8_t> DescribeOne(DepthSiftDescriber* describer, const DepthImage
   return out;
 }
 
+SiftDescriptorOptions UpAxisOptions() {
+  SiftDescriptorOptions options;
+  options.orientation = ImageOrientation::kUpAxis;
+  return options;
+}
+
 double L2(const uint8_t* a, const uint8_t* b) {
   double s = 0;
   for (int k = 0; k < kSiftDimension; ++k) s += (a[k] - b[k]) * double(a[k] - b[k]);
@@ -64,7 +70,7 @@ TEST(SiftDescriptorTest, Rotate180IsAnInvolutivePermutation) {
 }
 
 TEST(SiftDescriptorTest, SymmetrisedDescriptorIgnoresTheUpAxisSign) {
-  DepthSiftDescriber describer{SiftDescriptorOptions()};
+  DepthSiftDescriber describer{UpAxisOptions()};
   for (uint32_t seed = 0; seed < 5; ++seed) {
     const DepthImage image = RandomSmoothImage(21, seed);
     const auto a = DescribeOne(&describer, image);
@@ -77,7 +83,7 @@ TEST(SiftDescriptorTest, SymmetrisedDescriptorIgnoresTheUpAxisSign) {
 TEST(SiftDescriptorTest, PermutationMatchesOpenCvOnTurnedImage) {
   // Without symmetrisation, the descriptor of the turned image is the
   // permuted descriptor: this checks Rotate180Index against OpenCV's layout.
-  SiftDescriptorOptions options;
+  SiftDescriptorOptions options = UpAxisOptions();
   options.symmetrize_180 = false;
   DepthSiftDescriber describer(options);
   const DepthImage image = RandomSmoothImage(21, 42);
@@ -90,7 +96,7 @@ TEST(SiftDescriptorTest, PermutationMatchesOpenCvOnTurnedImage) {
 }
 
 TEST(SiftDescriptorTest, DescriptorIsNormalisedAndDistinguishesImages) {
-  DepthSiftDescriber describer{SiftDescriptorOptions()};
+  DepthSiftDescriber describer{UpAxisOptions()};
   const auto a = DescribeOne(&describer, RandomSmoothImage(21, 1));
   const auto b = DescribeOne(&describer, RandomSmoothImage(21, 2));
   double sq = 0;
@@ -100,7 +106,7 @@ TEST(SiftDescriptorTest, DescriptorIsNormalisedAndDistinguishesImages) {
 }
 
 TEST(SiftDescriptorTest, ContrastScaleDoesNotMatterWithStretch) {
-  SiftDescriptorOptions options;
+  SiftDescriptorOptions options = UpAxisOptions();
   options.depth_to_gray = DepthToGray::kStretch;
   DepthSiftDescriber describer(options);
   DepthImage image = RandomSmoothImage(21, 3);

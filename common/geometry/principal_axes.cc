@@ -49,30 +49,55 @@ void SymmetricEigen3(const std::array<std::array<double, 3>, 3>& matrix,
   }
 }
 
-PrincipalAxes ComputePrincipalAxes(const std::vector<Vec3f>& points,
-                                   const std::vector<uint32_t>* subset) {
-  const std::size_t n = subset ? subset->size() : points.size();
-  auto at = [&](std::size_t i) { return Vec3d(points[subset ? (*subset)[i] : i]); };
+namespace {
+
+PrincipalAxes AxesOf(const Vec3d& center, std::array<std::array<double, 3>, 3> cov, double weight) {
   PrincipalAxes result;
-  Vec3d sum;
-  for (std::size_t i = 0; i < n; ++i) sum += at(i);
-  result.centroid = n > 0 ? sum / static_cast<double>(n) : Vec3d();
-  std::array<std::array<double, 3>, 3> cov{};
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3d d = at(i) - result.centroid;
-    for (int r = 0; r < 3; ++r) {
-      for (int c = r; c < 3; ++c) cov[r][c] += d[r] * d[c];
-    }
-  }
+  result.centroid = center;
   for (int r = 0; r < 3; ++r) {
     for (int c = r; c < 3; ++c) {
-      cov[r][c] /= std::max<std::size_t>(n, 1);
+      cov[r][c] /= weight > 0 ? weight : 1.0;
       cov[c][r] = cov[r][c];
     }
   }
   SymmetricEigen3(cov, &result.variances, &result.axes);
   result.axes[2] = Normalized(Cross(result.axes[0], result.axes[1]));
   return result;
+}
+
+}  // namespace
+
+PrincipalAxes ComputeWeightedPrincipalAxes(const std::vector<Vec3f>& points,
+                                           const std::vector<uint32_t>& subset,
+                                           const Vec3d& center, double radius) {
+  std::array<std::array<double, 3>, 3> cov{};
+  double total = 0;
+  for (const uint32_t i : subset) {
+    const Vec3d d = Vec3d(points[i]) - center;
+    const double w = std::max(0.0, radius - Norm(d));
+    total += w;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = r; c < 3; ++c) cov[r][c] += w * d[r] * d[c];
+    }
+  }
+  return AxesOf(center, cov, total);
+}
+
+PrincipalAxes ComputePrincipalAxes(const std::vector<Vec3f>& points,
+                                   const std::vector<uint32_t>* subset) {
+  const std::size_t n = subset ? subset->size() : points.size();
+  auto at = [&](std::size_t i) { return Vec3d(points[subset ? (*subset)[i] : i]); };
+  Vec3d sum;
+  for (std::size_t i = 0; i < n; ++i) sum += at(i);
+  const Vec3d centroid = n > 0 ? sum / static_cast<double>(n) : Vec3d();
+  std::array<std::array<double, 3>, 3> cov{};
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3d d = at(i) - centroid;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = r; c < 3; ++c) cov[r][c] += d[r] * d[c];
+    }
+  }
+  return AxesOf(centroid, cov, static_cast<double>(n));
 }
 
 }  // namespace meshseek

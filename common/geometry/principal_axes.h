@@ -27,6 +27,15 @@ struct PrincipalAxes {
 PrincipalAxes ComputePrincipalAxes(const std::vector<Vec3f>& points,
                                    const std::vector<uint32_t>* subset = nullptr);
 
+// Distance-weighted PCA about a given centre, as in SHOT's local reference
+// frame (Tombari et al., ECCV 2010): each point weighs (radius - |p - centre|),
+// so the nearest surface dominates and points entering or leaving the support
+// at its rim change the axes only slightly, which makes the axes repeatable
+// under resampling and small deformations. `centroid` is set to `center`.
+PrincipalAxes ComputeWeightedPrincipalAxes(const std::vector<Vec3f>& points,
+                                           const std::vector<uint32_t>& subset,
+                                           const Vec3d& center, double radius);
+
 // Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations
 // (exact to round-off, robust for repeated eigenvalues). Eigenvalues in
 // decreasing order, eigenvectors as unit columns in the same order.

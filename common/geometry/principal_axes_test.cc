@@ -37,6 +37,26 @@ TEST(PrincipalAxesTest, UsesOnlyTheSubset) {
   EXPECT_NEAR(pa.centroid.x, 1.0, 1e-12);
 }
 
+TEST(PrincipalAxesTest, WeightedAxesAreCentredOnTheGivenPointAndFavourNearPoints) {
+  // A plane z = 0 with a far wall at x = 0.9: plain PCA of the ball of radius
+  // 1 is pulled by the wall; distance weighting keeps the plane's normal.
+  std::vector<Vec3f> pts;
+  for (int i = -10; i <= 10; ++i) {
+    for (int j = -10; j <= 10; ++j) pts.emplace_back(0.1f * i, 0.05f * j, 0.0f);
+  }
+  for (int j = -10; j <= 10; ++j) {
+    for (int k = 0; k < 10; ++k) pts.emplace_back(0.9f, 0.05f * j, 0.05f * k);
+  }
+  std::vector<uint32_t> all(pts.size());
+  for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+  const PrincipalAxes weighted = ComputeWeightedPrincipalAxes(pts, all, Vec3d(0, 0, 0), 1.0);
+  EXPECT_EQ(weighted.centroid, Vec3d(0, 0, 0));
+  EXPECT_NEAR(std::abs(weighted.axes[2].z), 1.0, 2e-3);
+  EXPECT_NEAR(std::abs(weighted.axes[0].x), 1.0, 1e-3);  // the plane's long side
+  const PrincipalAxes plain = ComputePrincipalAxes(pts, &all);
+  EXPECT_LT(std::abs(plain.axes[2].z), std::abs(weighted.axes[2].z));
+}
+
 TEST(SymmetricEigen3Test, DiagonalisesAndHandlesRepeatedEigenvalues) {
   std::array<double, 3> values;
   std::array<Vec3d, 3> vectors;

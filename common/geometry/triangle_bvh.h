@@ -44,7 +44,7 @@ struct OrientedBox {
 
 class TriangleBvh {
  public:
-  static constexpr int kLeafSize = 4;
+  static constexpr int kLeafSize = 8;
 
   // Indexes every triangle of `mesh` (which must outlive nothing: the BVH
   // keeps only triangle boxes and indices).
