@@ -51,11 +51,11 @@ struct DepthSiftDescriber::Impl {
 DepthSiftDescriber::DepthSiftDescriber(const SiftDescriptorOptions& options)
     : impl_(std::make_unique<Impl>()) {
   impl_->options = options;
-  // Only sigma matters when describing keypoints of octave 0, layer 0; one
-  // octave layer (instead of 3) makes OpenCV build 4 pyramid images per call
-  // instead of 6, with bit-identical descriptors. The rest are detection
-  // parameters, unused here.
-  impl_->sift = cv::SIFT::create(0, 1, 0.04, 10, options.blur_sigma);
+  // Only sigma matters when describing keypoints of octave 0, layer 0; the
+  // rest are OpenCV's detection defaults. (OpenCV still builds the octave's
+  // other layers; fewer layers means coarser steps and longer blur kernels,
+  // measured slower.)
+  impl_->sift = cv::SIFT::create(0, 3, 0.04, 10, options.blur_sigma);
 }
 
 DepthSiftDescriber::~DepthSiftDescriber() = default;
