@@ -3,8 +3,9 @@
 
   plot_e_sweep.py OUT.png CSV [CSV ...] --series TAG=LABEL [--series ...] [--v V] [--epsilon EPS]
 
-Each series is the rows with that tag (first CSV column), at vocabulary size V and KL epsilon EPS;
-x = scale E, y = RP_excl micro (first tier, query excluded). Needs matplotlib (python3-matplotlib).
+Each series is the rows with that tag (first CSV column), optionally only those at vocabulary size V
+and KL epsilon EPS; x = scale E, y = RP_excl micro (first tier, query excluded). Needs matplotlib
+(python3-matplotlib).
 """
 import argparse
 import csv
@@ -14,7 +15,7 @@ import matplotlib
 matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 
-COLUMNS = ['tag', 'scale_E', 'V', 'epsilon', 'RP_excl_micro', 'RP_excl_macro', 'RP_incl_micro',
+COLUMNS = ['tag', 'scale', 'V', 'epsilon', 'RP_excl_micro', 'RP_excl_macro', 'RP_incl_micro',
            'NN_micro', 'ST_micro', 'DCG_micro', 'extract_s']
 
 
@@ -23,8 +24,8 @@ def main():
     ap.add_argument('out')
     ap.add_argument('csv', nargs='+')
     ap.add_argument('--series', action='append', required=True, help='TAG=LABEL')
-    ap.add_argument('--v', type=int, default=1000)
-    ap.add_argument('--epsilon', type=float, default=1e-10)
+    ap.add_argument('--v', type=int, default=None)
+    ap.add_argument('--epsilon', type=float, default=None)
     ap.add_argument('--reference', action='append', default=[], help='LABEL=VALUE horizontal line')
     ap.add_argument('--title', default='DLD-SIFT: R-precision against the scale E')
     args = ap.parse_args()
@@ -35,9 +36,10 @@ def main():
     fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=110)
     for spec in args.series:
         tag, label = spec.split('=', 1)
-        pts = sorted({float(r['scale_E']): float(r['RP_excl_micro']) for r in rows
-                      if r['tag'] == tag and int(r['V']) == args.v
-                      and abs(float(r['epsilon']) - args.epsilon) <= 1e-3 * args.epsilon}.items())
+        pts = sorted({float(r['scale']): float(r['RP_excl_micro']) for r in rows
+                      if r['tag'] == tag and (args.v is None or int(r['V']) == args.v)
+                      and (args.epsilon is None
+                           or abs(float(r['epsilon']) - args.epsilon) <= 1e-3 * args.epsilon)}.items())
         if not pts:
             raise SystemExit(f'no rows for tag {tag} at V={args.v}, epsilon={args.epsilon}')
         ax.plot([p[0] for p in pts], [p[1] for p in pts], marker='o', label=label)

@@ -25,7 +25,8 @@
 #include "common/pipeline/retrieval_pipeline.h"
 
 ABSL_FLAG(std::string, manifest, "", "CSV manifest id,class,path");
-ABSL_FLAG(std::string, scales, "0.25", "comma-separated DLD-SIFT scales E");
+ABSL_FLAG(std::string, scales, "0.2",
+          "comma-separated scales: E for --method dld, C (scale factor) for ld and rld");
 ABSL_FLAG(std::string, vocabularies, "1000", "comma-separated codebook sizes V");
 ABSL_FLAG(std::string, epsilons, "", "comma-separated KL epsilons (default: the shipped one)");
 ABSL_FLAG(std::string, csv, "", "append result rows to this CSV file");
@@ -69,9 +70,12 @@ int main(int argc, char** argv) {
   std::vector<std::string> labels;
   for (const auto& m : *models) labels.push_back(m.label);
 
-  std::printf("tag,scale_E,V,epsilon,RP_excl_micro,RP_excl_macro,RP_incl_micro,NN_micro,ST_micro,DCG_micro,extract_s\n");
+  std::printf("tag,scale,V,epsilon,RP_excl_micro,RP_excl_macro,RP_incl_micro,NN_micro,ST_micro,DCG_micro,extract_s\n");
   for (double scale : ParseList<double>(absl::GetFlag(FLAGS_scales))) {
+    // The method's scale knob: E for DLD-SIFT, C for the scale-space methods.
     options.extractor.dld.scale = scale;
+    options.extractor.ld.scale_space.scale_factor = scale;
+    options.extractor.rld.scale_space.scale_factor = scale;
     const auto start = std::chrono::steady_clock::now();
     auto features = ExtractCollection(*models, options);
     if (!features.ok()) {
@@ -90,7 +94,7 @@ int main(int argc, char** argv) {
       auto histograms = EncodeCollection(*codebook, *features, options);
       for (double eps : epsilons) {
         options.kl.epsilon = eps;
-        auto distances = SymmetricKlDistanceMatrix(*histograms, options.kl, options.num_threads);
+        auto distances = RankCollection(*histograms, options);
         auto metrics = EvaluateRetrieval(labels, *distances, options.num_threads);
         const std::string row = absl::StrFormat(
             "%s,%g,%d,%g,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.1f", absl::GetFlag(FLAGS_tag), scale, v, eps,

@@ -9,25 +9,35 @@
 namespace {
 const meshseek::RetrievalPipelineOptions kDefaults;
 const meshseek::DldSiftOptions& kDld = kDefaults.extractor.dld;
+const meshseek::RldSiftOptions& kRld = kDefaults.extractor.rld;
 }  // namespace
 
-ABSL_FLAG(std::string, method, "dld", "local feature method: dld (DLD-SIFT)");
+ABSL_FLAG(std::string, method, "dld",
+          "local feature method: dld (DLD-SIFT, dense) | rld (RLD-SIFT, resampled) | ld (LD-SIFT)");
 ABSL_FLAG(double, scale, kDld.scale,
-          "support radius E relative to the minimum enclosing sphere (s = E * D / 2)");
-ABSL_FLAG(int, points, kDld.num_points, "DLD-SIFT feature points per model (N_DLD)");
-ABSL_FLAG(int, image_size, kDld.depth_image.image_size, "depth image side I in pixels (odd)");
+          "dld: support radius E relative to the minimum enclosing sphere (s = E * D / 2)");
+ABSL_FLAG(int, points, kDld.num_points, "dld: feature points per model (N_DLD)");
 ABSL_FLAG(int, frame_samples, kDld.frame_samples_per_support,
-          "dense surface samples per support disc for the local PCA frame");
+          "dld: dense surface samples per support disc for the local PCA frame");
+ABSL_FLAG(int, rld_samples, kRld.num_samples, "rld: resample points (N_RLD)");
+ABSL_FLAG(int, rld_neighbors, kRld.neighbors, "rld: k of the k-nearest-neighbour graph");
+ABSL_FLAG(int, levels, kRld.scale_space.levels, "ld, rld: scale-space levels L");
+ABSL_FLAG(double, scale_factor, kRld.scale_space.scale_factor,
+          "ld, rld: C in the feature scale s = C * d * sqrt(level)");
 ABSL_FLAG(bool, weighted_frame, kDld.weighted_frame,
-          "distance-weighted (SHOT-style) PCA frame instead of plain PCA");
-ABSL_FLAG(std::string, orientation,
-          kDld.descriptor.orientation == meshseek::ImageOrientation::kDominant ? "dominant" : "up",
-          "descriptor rotation: dominant (Lowe's gradient peaks) | up (PCA up axis + 180-degree sum)");
-ABSL_FLAG(std::string, depth_to_gray,
-          kDld.descriptor.depth_to_gray == meshseek::DepthToGray::kStretch ? "stretch" : "fixed",
-          "depth to grey mapping: fixed (2s range) | stretch (image range)");
+          "dld, rld: distance-weighted (SHOT-style) PCA frame instead of plain PCA");
+ABSL_FLAG(int, image_size, kDld.depth_image.image_size, "depth image side I in pixels (odd)");
+ABSL_FLAG(std::string, orientation, "",
+          "descriptor rotation: dominant (Lowe's gradient peaks) | up (PCA up axis + 180-degree "
+          "sum); empty: the method's default");
+ABSL_FLAG(std::string, depth_to_gray, "",
+          "depth to grey mapping: fixed (2s range) | stretch (image range); empty: the method's "
+          "default");
 ABSL_FLAG(double, blur_sigma, kDld.descriptor.blur_sigma, "SIFT blur sigma in pixels");
 ABSL_FLAG(int, vocabulary, kDefaults.kmeans.num_centroids, "codebook size V (k-means centroids)");
+ABSL_FLAG(int, kmeans_points_per_centroid, kDefaults.kmeans.max_points_per_centroid,
+          "k-means trains on at most this many sampled local features per centroid");
+ABSL_FLAG(int, kmeans_iterations, kDefaults.kmeans.max_iterations, "maximum k-means iterations");
 ABSL_FLAG(uint64_t, seed, kDefaults.kmeans.seed,
           "seed of every random choice (k-means sampling and seeding; synth shapes)");
 ABSL_FLAG(double, kl_epsilon, kDefaults.kl.epsilon,
@@ -36,36 +46,62 @@ ABSL_FLAG(int, threads, kDefaults.num_threads, "threads (0: all cores)");
 ABSL_FLAG(bool, progress, true, "show progress bars on stderr");
 
 namespace meshseek::cli {
+namespace {
 
-absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags() {
-  RetrievalPipelineOptions options;
-  MESHSEEK_ASSIGN_OR_RETURN(options.extractor.method, ParseFeatureMethod(absl::GetFlag(FLAGS_method)));
-  DldSiftOptions& dld = options.extractor.dld;
-  dld.scale = absl::GetFlag(FLAGS_scale);
-  dld.num_points = absl::GetFlag(FLAGS_points);
-  dld.depth_image.image_size = absl::GetFlag(FLAGS_image_size);
-  dld.frame_samples_per_support = absl::GetFlag(FLAGS_frame_samples);
-  dld.weighted_frame = absl::GetFlag(FLAGS_weighted_frame);
+absl::Status ApplyDescriptorFlags(SiftDescriptorOptions* descriptor) {
   const std::string orientation = absl::GetFlag(FLAGS_orientation);
   if (orientation == "dominant") {
-    dld.descriptor.orientation = ImageOrientation::kDominant;
+    descriptor->orientation = ImageOrientation::kDominant;
   } else if (orientation == "up") {
-    dld.descriptor.orientation = ImageOrientation::kUpAxis;
-  } else {
+    descriptor->orientation = ImageOrientation::kUpAxis;
+  } else if (!orientation.empty()) {
     return absl::InvalidArgumentError(
         absl::StrCat("--orientation must be 'dominant' or 'up', got '", orientation, "'"));
   }
   const std::string gray = absl::GetFlag(FLAGS_depth_to_gray);
   if (gray == "fixed") {
-    dld.descriptor.depth_to_gray = DepthToGray::kFixedRange;
+    descriptor->depth_to_gray = DepthToGray::kFixedRange;
   } else if (gray == "stretch") {
-    dld.descriptor.depth_to_gray = DepthToGray::kStretch;
-  } else {
+    descriptor->depth_to_gray = DepthToGray::kStretch;
+  } else if (!gray.empty()) {
     return absl::InvalidArgumentError(
         absl::StrCat("--depth_to_gray must be 'fixed' or 'stretch', got '", gray, "'"));
   }
-  dld.descriptor.blur_sigma = absl::GetFlag(FLAGS_blur_sigma);
+  descriptor->blur_sigma = absl::GetFlag(FLAGS_blur_sigma);
+  return absl::OkStatus();
+}
+
+void ApplyScaleSpaceFlags(ScaleSpaceOptions* scale_space) {
+  scale_space->levels = absl::GetFlag(FLAGS_levels);
+  scale_space->scale_factor = absl::GetFlag(FLAGS_scale_factor);
+}
+
+}  // namespace
+
+absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags() {
+  RetrievalPipelineOptions options;
+  ExtractorOptions& extractor = options.extractor;
+  MESHSEEK_ASSIGN_OR_RETURN(extractor.method, ParseFeatureMethod(absl::GetFlag(FLAGS_method)));
+  extractor.dld.scale = absl::GetFlag(FLAGS_scale);
+  extractor.dld.num_points = absl::GetFlag(FLAGS_points);
+  extractor.dld.frame_samples_per_support = absl::GetFlag(FLAGS_frame_samples);
+  extractor.dld.weighted_frame = absl::GetFlag(FLAGS_weighted_frame);
+  extractor.rld.num_samples = absl::GetFlag(FLAGS_rld_samples);
+  extractor.rld.neighbors = absl::GetFlag(FLAGS_rld_neighbors);
+  extractor.rld.weighted_frame = absl::GetFlag(FLAGS_weighted_frame);
+  ApplyScaleSpaceFlags(&extractor.ld.scale_space);
+  ApplyScaleSpaceFlags(&extractor.rld.scale_space);
+  for (DepthImageOptions* image :
+       {&extractor.dld.depth_image, &extractor.ld.depth_image, &extractor.rld.depth_image}) {
+    image->image_size = absl::GetFlag(FLAGS_image_size);
+  }
+  for (SiftDescriptorOptions* descriptor :
+       {&extractor.dld.descriptor, &extractor.ld.descriptor, &extractor.rld.descriptor}) {
+    MESHSEEK_RETURN_IF_ERROR(ApplyDescriptorFlags(descriptor));
+  }
   options.kmeans.num_centroids = absl::GetFlag(FLAGS_vocabulary);
+  options.kmeans.max_points_per_centroid = absl::GetFlag(FLAGS_kmeans_points_per_centroid);
+  options.kmeans.max_iterations = absl::GetFlag(FLAGS_kmeans_iterations);
   options.kmeans.seed = absl::GetFlag(FLAGS_seed);
   options.kl.epsilon = absl::GetFlag(FLAGS_kl_epsilon);
   options.num_threads = absl::GetFlag(FLAGS_threads);

@@ -5,11 +5,10 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/base/status_macros.h"
+#include "common/features/local_depth_sift.h"
 #include "common/geometry/enclosing_sphere.h"
 #include "common/geometry/point_grid.h"
-#include "common/geometry/principal_axes.h"
 #include "common/geometry/surface_sampler.h"
-#include "common/geometry/triangle_bvh.h"
 
 namespace meshseek {
 
@@ -50,35 +49,16 @@ absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh, const Dld
       std::ceil(wanted), options.min_frame_samples, options.max_frame_samples));
   MESHSEEK_ASSIGN_OR_RETURN(const SurfacePoints dense, SampleSurface(mesh, frame_count));
   const PointGrid grid(dense.positions, static_cast<float>(s));
-  const TriangleBvh bvh(mesh);
-  DepthImageRenderer renderer(mesh, bvh, options.depth_image);
-  DepthSiftDescriber describer(options.descriptor);
+  LocalDepthSift describer(mesh, options.depth_image, options.descriptor);
 
   LocalFeatures features;
   features.keypoints.reserve(2 * centres.size());
   features.descriptors.reserve(2 * centres.size() * kSiftDimension);
   std::vector<uint32_t> support;
-  DepthImage front, back;
-  for (std::size_t i = 0; i < centres.size(); ++i) {
-    const Vec3f& p = centres.positions[i];
-    support.clear();
-    grid.RadiusQuery(p, static_cast<float>(s), &support);
-    if (support.size() < 3) continue;
-    const PrincipalAxes axes =
-        options.weighted_frame
-            ? ComputeWeightedPrincipalAxes(dense.positions, support, Vec3d(p), s)
-            : ComputePrincipalAxes(dense.positions, &support);
-    const ViewFrame frame{Vec3d(p), axes.axes[0], axes.axes[2], s};
-    renderer.RenderPair(frame, &front, options.two_views ? &back : nullptr);
-    for (int view = 0; view < (options.two_views ? 2 : 1); ++view) {
-      DepthImage& image = view == 0 ? front : back;
-      if (!FinishDepthImage(&image)) continue;
-      const int described = describer.Describe(image, &features.descriptors);
-      const Vec3f forward(view == 0 ? -frame.normal : frame.normal);
-      for (int k = 0; k < described; ++k) {
-        features.keypoints.push_back({p, forward, Vec3f(frame.up), static_cast<float>(s), 0});
-      }
-    }
+  for (const Vec3f& p : centres.positions) {
+    const auto axes = SupportAxes(dense.positions, grid, p, s, options.weighted_frame, &support);
+    if (!axes) continue;
+    describer.Describe({Vec3d(p), axes->axes[0], axes->axes[2], s}, options.two_views, 0, &features);
   }
   if (features.keypoints.empty()) {
     return absl::InvalidArgumentError("DLD-SIFT found no usable feature point on the model");

@@ -3,16 +3,36 @@
 #include "absl/strings/str_cat.h"
 
 namespace meshseek {
+namespace {
+
+void DescriptorToJson(const SiftDescriptorOptions& d, Json* json) {
+  json->Set("depth_to_gray", d.depth_to_gray == DepthToGray::kFixedRange ? "fixed_range" : "stretch");
+  json->Set("orientation",
+            d.orientation == ImageOrientation::kUpAxis ? "up_axis_180_sum" : "dominant_gradient");
+  json->Set("sift_blur_sigma", d.blur_sigma);
+}
+
+void ScaleSpaceToJson(const ScaleSpaceOptions& s, Json* json) {
+  json->Set("levels_L", s.levels);
+  json->Set("scale_factor_C", s.scale_factor);
+  json->Set("support_radius", "C * d * sqrt(l) (d: mean edge length at the point, l: level)");
+}
+
+}  // namespace
 
 absl::StatusOr<FeatureMethod> ParseFeatureMethod(absl::string_view name) {
   if (name == "dld") return FeatureMethod::kDldSift;
+  if (name == "ld") return FeatureMethod::kLdSift;
+  if (name == "rld") return FeatureMethod::kRldSift;
   return absl::InvalidArgumentError(
-      absl::StrCat("unknown feature method '", name, "' (known: dld)"));
+      absl::StrCat("unknown feature method '", name, "' (known: dld, ld, rld)"));
 }
 
 const char* FeatureMethodName(FeatureMethod method) {
   switch (method) {
     case FeatureMethod::kDldSift: return "dld";
+    case FeatureMethod::kLdSift: return "ld";
+    case FeatureMethod::kRldSift: return "rld";
   }
   return "?";
 }
@@ -20,6 +40,8 @@ const char* FeatureMethodName(FeatureMethod method) {
 absl::Status ExtractorOptions::Validate() const {
   switch (method) {
     case FeatureMethod::kDldSift: return dld.Validate();
+    case FeatureMethod::kLdSift: return ld.Validate();
+    case FeatureMethod::kRldSift: return rld.Validate();
   }
   return absl::InvalidArgumentError("unknown feature method");
 }
@@ -28,7 +50,7 @@ Json ExtractorOptions::ToJson() const {
   Json json = Json::MakeObject();
   json.Set("method", FeatureMethodName(method));
   switch (method) {
-    case FeatureMethod::kDldSift: {
+    case FeatureMethod::kDldSift:
       json.Set("num_points", dld.num_points);
       json.Set("scale_E", dld.scale);
       json.Set("support_radius", "E * D / 2 (D: minimum enclosing sphere diameter)");
@@ -36,15 +58,24 @@ Json ExtractorOptions::ToJson() const {
       json.Set("frame_samples_per_support", dld.frame_samples_per_support);
       json.Set("weighted_frame", dld.weighted_frame);
       json.Set("image_size", dld.depth_image.image_size);
-      json.Set("depth_to_gray",
-               dld.descriptor.depth_to_gray == DepthToGray::kFixedRange ? "fixed_range" : "stretch");
-      json.Set("orientation", dld.descriptor.orientation == ImageOrientation::kUpAxis
-                                  ? "up_axis_180_sum"
-                                  : "dominant_gradient");
-      json.Set("sift_blur_sigma", dld.descriptor.blur_sigma);
-      json.Set("symmetrize_180", dld.descriptor.symmetrize_180);
+      DescriptorToJson(dld.descriptor, &json);
       break;
-    }
+    case FeatureMethod::kLdSift:
+      ScaleSpaceToJson(ld.scale_space, &json);
+      json.Set("graph", "mesh vertex 1-ring (OpenMesh)");
+      json.Set("two_views", false);
+      json.Set("image_size", ld.depth_image.image_size);
+      DescriptorToJson(ld.descriptor, &json);
+      break;
+    case FeatureMethod::kRldSift:
+      json.Set("num_samples_N_RLD", rld.num_samples);
+      json.Set("neighbors_k", rld.neighbors);
+      ScaleSpaceToJson(rld.scale_space, &json);
+      json.Set("two_views", rld.two_views);
+      json.Set("weighted_frame", rld.weighted_frame);
+      json.Set("image_size", rld.depth_image.image_size);
+      DescriptorToJson(rld.descriptor, &json);
+      break;
   }
   return json;
 }
@@ -53,6 +84,8 @@ absl::StatusOr<LocalFeatures> ExtractLocalFeatures(const TriangleMesh& mesh,
                                                    const ExtractorOptions& options) {
   switch (options.method) {
     case FeatureMethod::kDldSift: return ExtractDldSift(mesh, options.dld);
+    case FeatureMethod::kLdSift: return ExtractLdSift(mesh, options.ld);
+    case FeatureMethod::kRldSift: return ExtractRldSift(mesh, options.rld);
   }
   return absl::InvalidArgumentError("unknown feature method");
 }

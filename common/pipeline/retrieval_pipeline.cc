@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <limits>
 #include <numeric>
 
 #include "absl/strings/str_cat.h"
@@ -100,6 +101,7 @@ absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
   std::vector<std::vector<float>> histograms(features.size());
   std::vector<absl::Status> errors(features.size());
   ParallelFor(features.size(), options.num_threads, [&](std::size_t i) {
+    if (features[i].size() == 0) return;  // no histogram: see RankCollection
     auto histogram = codebook.Encode(features[i].descriptors.data(), features[i].size());
     if (histogram.ok()) {
       histograms[i] = *std::move(histogram);
@@ -115,6 +117,28 @@ absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
   return histograms;
 }
 
+absl::StatusOr<std::vector<float>> RankCollection(const std::vector<std::vector<float>>& histograms,
+                                                  const RetrievalPipelineOptions& options) {
+  const std::size_t n = histograms.size();
+  std::vector<std::size_t> present;
+  std::vector<std::vector<float>> compared;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (histograms[i].empty()) continue;
+    present.push_back(i);
+    compared.push_back(histograms[i]);
+  }
+  std::vector<float> distances(n * n, std::numeric_limits<float>::infinity());
+  for (std::size_t i = 0; i < n; ++i) distances[i * n + i] = 0;
+  if (compared.empty()) return distances;
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<float> sub,
+                            SymmetricKlDistanceMatrix(compared, options.kl, options.num_threads));
+  const std::size_t m = present.size();
+  for (std::size_t a = 0; a < m; ++a) {
+    for (std::size_t b = 0; b < m; ++b) distances[present[a] * n + present[b]] = sub[a * m + b];
+  }
+  return distances;
+}
+
 absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<ManifestEntry>& models,
                                                         const RetrievalPipelineOptions& options) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
@@ -127,7 +151,14 @@ absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<Manife
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<LocalFeatures> features,
                             ExtractCollection(models, options));
   result.timings.extract_seconds = SecondsSince(stage);
-  for (const LocalFeatures& f : features) result.features_per_model.push_back(f.size());
+  for (const LocalFeatures& f : features) {
+    result.features_per_model.push_back(f.size());
+    if (f.size() == 0) ++result.models_without_features;
+  }
+  if (result.models_without_features > 0) {
+    MESHSEEK_LOG(WARNING) << result.models_without_features << " of " << models.size()
+                          << " models have no local features; they are ranked last for every query";
+  }
 
   stage = std::chrono::steady_clock::now();
   MESHSEEK_ASSIGN_OR_RETURN(const Codebook codebook, TrainCollectionCodebook(features, options));
@@ -139,8 +170,7 @@ absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<Manife
   result.timings.encode_seconds = SecondsSince(stage);
 
   stage = std::chrono::steady_clock::now();
-  MESHSEEK_ASSIGN_OR_RETURN(result.distances,
-                            SymmetricKlDistanceMatrix(histograms, options.kl, options.num_threads));
+  MESHSEEK_ASSIGN_OR_RETURN(result.distances, RankCollection(histograms, options));
   result.timings.rank_seconds = SecondsSince(stage);
 
   std::vector<std::string> labels;
@@ -174,6 +204,7 @@ absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
     counts.Set("min_per_model", static_cast<int64_t>(sorted.front()));
     counts.Set("median_per_model", static_cast<int64_t>(sorted[sorted.size() / 2]));
     counts.Set("max_per_model", static_cast<int64_t>(sorted.back()));
+    counts.Set("models_without_features", static_cast<int64_t>(evaluation.models_without_features));
   }
   Json& timings = report.Set("timings_seconds", Json::MakeObject());
   timings.Set("extract", evaluation.timings.extract_seconds);

@@ -58,10 +58,19 @@ absl::StatusOr<std::vector<LocalFeatures>> ExtractCollection(
 absl::StatusOr<Codebook> TrainCollectionCodebook(const std::vector<LocalFeatures>& features,
                                                  const RetrievalPipelineOptions& options);
 
-// One normalised histogram per model.
+// One normalised histogram per model; an empty one for a model without local
+// features (LD-SIFT and RLD-SIFT may detect nothing on a model).
 absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
     const Codebook& codebook, const std::vector<LocalFeatures>& features,
     const RetrievalPipelineOptions& options);
+
+// All-pairs symmetric KL distances, N x N row-major. A model without features
+// (empty histogram) cannot be compared: its distance to every other model is
+// +infinity (0 to itself), so it is ranked last by every query and, as a
+// query, finds all others tied (broken by index). Such models are counted in
+// the report rather than silently given an arbitrary histogram.
+absl::StatusOr<std::vector<float>> RankCollection(const std::vector<std::vector<float>>& histograms,
+                                                  const RetrievalPipelineOptions& options);
 
 struct StageTimings {
   double extract_seconds = 0;
@@ -74,6 +83,7 @@ struct StageTimings {
 struct CollectionEvaluation {
   std::vector<ManifestEntry> models;           // input order = matrix order
   std::vector<std::size_t> features_per_model;
+  std::size_t models_without_features = 0;
   std::size_t codebook_size = 0;
   std::vector<float> distances;  // N x N row-major, entry i*N+j = D(model i, model j)
   RetrievalMetrics metrics;

@@ -1,0 +1,52 @@
+// What every LD-SIFT variant does once it has a feature point and its
+// support radius s (DESIGN.md 2.2, 2.3): a local frame from the surface points
+// within s, one or two depth images of the original triangles, and their SIFT
+// descriptors. DLD-SIFT, LD-SIFT and RLD-SIFT differ only in where the points,
+// radii and view directions come from.
+#ifndef MESHSEEK_COMMON_FEATURES_LOCAL_DEPTH_SIFT_H_
+#define MESHSEEK_COMMON_FEATURES_LOCAL_DEPTH_SIFT_H_
+
+#include <optional>
+#include <vector>
+
+#include "common/features/depth_image.h"
+#include "common/features/local_features.h"
+#include "common/features/sift_descriptor.h"
+#include "common/geometry/mesh.h"
+#include "common/geometry/point_grid.h"
+#include "common/geometry/principal_axes.h"
+#include "common/geometry/triangle_bvh.h"
+
+namespace meshseek {
+
+// PCA axes of the points within distance s of p (found through `grid`, which
+// indexes `points`), or nullopt if fewer than 3 lie there: such a point yields
+// no feature. `weighted`: SHOT-style (s - distance) weights about p instead of
+// plain PCA about the centroid. `scratch` holds the support between calls.
+std::optional<PrincipalAxes> SupportAxes(const std::vector<Vec3f>& points, const PointGrid& grid,
+                                         const Vec3f& p, double s, bool weighted,
+                                         std::vector<uint32_t>* scratch);
+
+// Renders and describes local depth images of one mesh. Holds the mesh's BVH
+// and OpenCV state: one per thread and model; the mesh must outlive it.
+class LocalDepthSift {
+ public:
+  LocalDepthSift(const TriangleMesh& mesh, const DepthImageOptions& image_options,
+                 const SiftDescriptorOptions& descriptor_options);
+
+  // Appends the features of the front view of `frame` (camera at p + s n
+  // looking along -n) and, if `two_views`, of the back view, each image giving
+  // one or more descriptors (SiftDescriptorOptions::orientation); a view that
+  // sees nothing gives none. Keypoints record `level`.
+  void Describe(const ViewFrame& frame, bool two_views, int level, LocalFeatures* out);
+
+ private:
+  TriangleBvh bvh_;
+  DepthImageRenderer renderer_;
+  DepthSiftDescriber describer_;
+  DepthImage front_, back_;
+};
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_COMMON_FEATURES_LOCAL_DEPTH_SIFT_H_

@@ -1,0 +1,58 @@
+#include "common/features/rld_sift.h"
+
+#include <algorithm>
+
+#include "absl/strings/str_cat.h"
+#include "common/base/status_macros.h"
+#include "common/features/local_depth_sift.h"
+#include "common/geometry/point_graph.h"
+#include "common/geometry/point_grid.h"
+
+namespace meshseek {
+
+absl::Status RldSiftOptions::Validate() const {
+  if (num_samples < 100 || num_samples > 10000000) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("RLD-SIFT num_samples must be in [100, 10000000], got ", num_samples));
+  }
+  if (neighbors < 1 || neighbors > 100) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("RLD-SIFT neighbors k must be in [1, 100], got ", neighbors));
+  }
+  MESHSEEK_RETURN_IF_ERROR(scale_space.Validate());
+  MESHSEEK_RETURN_IF_ERROR(depth_image.Validate());
+  return descriptor.Validate();
+}
+
+absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh, const RldSiftOptions& options,
+                                             SurfacePoints* resampled,
+                                             std::vector<InterestPoint>* detected) {
+  MESHSEEK_RETURN_IF_ERROR(options.Validate());
+  MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));
+  MESHSEEK_ASSIGN_OR_RETURN(SurfacePoints samples, SampleSurface(mesh, options.num_samples));
+  MESHSEEK_ASSIGN_OR_RETURN(const PointGraph graph,
+                            SymmetricKnnGraph(samples.positions, options.neighbors));
+  std::vector<InterestPoint> points = DetectInterestPoints(graph, options.scale_space);
+  LocalFeatures features;
+  if (!points.empty()) {
+    std::vector<float> scales;
+    for (const InterestPoint& ip : points) scales.push_back(ip.scale);
+    std::nth_element(scales.begin(), scales.begin() + scales.size() / 2, scales.end());
+    const PointGrid grid(samples.positions, std::max(scales[scales.size() / 2], 1e-12f));
+    LocalDepthSift describer(mesh, options.depth_image, options.descriptor);
+    std::vector<uint32_t> support;
+    for (const InterestPoint& ip : points) {
+      const Vec3f& p = samples.positions[ip.vertex];
+      const auto axes =
+          SupportAxes(samples.positions, grid, p, ip.scale, options.weighted_frame, &support);
+      if (!axes) continue;
+      describer.Describe({Vec3d(p), axes->axes[0], axes->axes[2], ip.scale}, options.two_views,
+                         ip.level, &features);
+    }
+  }
+  if (resampled != nullptr) *resampled = std::move(samples);
+  if (detected != nullptr) *detected = std::move(points);
+  return features;
+}
+
+}  // namespace meshseek

@@ -1,0 +1,53 @@
+// RLD-SIFT: resampled LD-SIFT (Ohishi & Ohbuchi 2013, sec. 3.1; DESIGN.md
+// 2.6). The surface is resampled with N_RLD area-uniform Sobol points
+// (SampleSurface), each joined to its k nearest neighbours (symmetrised), and
+// LD-SIFT's scale-space detector runs on that graph, so interest points no
+// longer depend on the input's tessellation, manifoldness or components.
+// Each interest point is then described like a DLD-SIFT point: a local frame
+// from the resample points within its scale s = C * d * sqrt(l), and two
+// depth images of the original triangles (into and out of the surface).
+#ifndef MESHSEEK_COMMON_FEATURES_RLD_SIFT_H_
+#define MESHSEEK_COMMON_FEATURES_RLD_SIFT_H_
+
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "common/features/depth_image.h"
+#include "common/features/local_features.h"
+#include "common/features/scale_space.h"
+#include "common/features/sift_descriptor.h"
+#include "common/geometry/mesh.h"
+#include "common/geometry/surface_sampler.h"
+
+namespace meshseek {
+
+struct RldSiftOptions {
+  /// N_RLD, resample points (the paper: 15,000).
+  int num_samples = 15000;
+  /// k of the k-nearest-neighbour graph (the paper: 10).
+  int neighbors = 10;
+  /// Detector: L = 20 levels, C = 5.
+  ScaleSpaceOptions scale_space;
+  /// Render the back view too (the paper's two views).
+  bool two_views = true;
+  /// SHOT-style distance-weighted PCA frame (as DLD-SIFT's default).
+  bool weighted_frame = true;
+  /// Depth image size I.
+  DepthImageOptions depth_image;
+  /// Descriptor parameters.
+  SiftDescriptorOptions descriptor;
+
+  absl::Status Validate() const;
+};
+
+// Extracts RLD-SIFT features. `resampled` and `detected`, if given, receive
+// the resample points and the interest points (vertex = resample index). A
+// model with no interest point gives an empty set, not an error.
+absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh, const RldSiftOptions& options,
+                                             SurfacePoints* resampled = nullptr,
+                                             std::vector<InterestPoint>* detected = nullptr);
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_COMMON_FEATURES_RLD_SIFT_H_
