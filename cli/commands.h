@@ -3,12 +3,15 @@
 #ifndef MESHSEEK_CLI_COMMANDS_H_
 #define MESHSEEK_CLI_COMMANDS_H_
 
+#include <string>
+
 #include "absl/status/status.h"
 
 namespace meshseek::cli {
 
 absl::Status RunEval();
 absl::Status RunSynth();
+absl::Status RunInspect(const std::string& model_path);
 
 }  // namespace meshseek::cli
 

@@ -2,6 +2,7 @@
 //
 //   meshseek eval  --manifest FILE --method dld --out DIR [options]
 //   meshseek synth --out DIR [--models_per_class N] [--seed S]
+//   meshseek inspect MODEL --method ld|rld|dld --out DIR
 //
 // Flags are parsed here and only here, turned into validated option structs,
 // and handed to the core (common/). See `meshseek --help`.
@@ -34,6 +35,10 @@ Commands:
   synth  Write the built-in labelled synthetic benchmark (procedural shapes):
            meshseek synth --out DIR
          writes DIR/manifest.csv, DIR/synthetic.cla and DIR/models/.
+  inspect  Show what a method detects and renders on one model:
+           meshseek inspect MODEL --method rld --out DIR
+         writes DIR/points.ply (feature points coloured by level), DIR/points.png
+         (the model with its visible feature points) and DIR/depth_images.png.
 
 Run `meshseek --helpfull` for every flag.)";
 
@@ -51,20 +56,24 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", kUsage);
     return 2;
   }
-  if (args.size() > 2) {
+  const std::string command = args[1];
+  const std::size_t positional = command == "inspect" ? 3 : 2;
+  if (args.size() > positional) {
     return Fail(absl::InvalidArgumentError(
-        absl::StrCat("unexpected argument '", args[2], "' (options are --flags)")));
+        absl::StrCat("unexpected argument '", args[positional], "' (options are --flags)")));
   }
   cv::setNumThreads(0);  // meshseek parallelises across models itself
-  const std::string command = args[1];
   absl::Status status;
   if (command == "eval") {
     status = meshseek::cli::RunEval();
   } else if (command == "synth") {
     status = meshseek::cli::RunSynth();
+  } else if (command == "inspect") {
+    status = args.size() < 3 ? absl::InvalidArgumentError("inspect needs a MODEL file")
+                             : meshseek::cli::RunInspect(args[2]);
   } else {
     status = absl::InvalidArgumentError(
-        absl::StrCat("unknown command '", command, "' (commands: eval, synth)"));
+        absl::StrCat("unknown command '", command, "' (commands: eval, synth, inspect)"));
   }
   return status.ok() ? 0 : Fail(status);
 }
