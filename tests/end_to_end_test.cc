@@ -117,6 +117,42 @@ TEST_F(EndToEndTest, CliEvalWritesMatrixAndMetricsThatTheReferenceEvaluatorAgree
   EXPECT_EQ(matched, 2);
 }
 
+TEST_F(EndToEndTest, EveryMethodRunsThroughTheCliWithTheSameOutputs) {
+  // LD-SIFT and RLD-SIFT behind the same interface as DLD-SIFT (small
+  // settings: the point here is the plumbing; accuracy is measured in bench/).
+  for (const std::string method : {"ld", "rld"}) {
+    const std::string out = *dir_ + "/eval_" + method;
+    std::string output;
+    const int code = RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --progress=false --manifest " +
+                                    *dir_ + "/bench/manifest.csv --method " + method +
+                                    " --rld_samples 3000 --vocabulary 100 --out " + out,
+                                &output);
+    ASSERT_EQ(code, 0) << output;
+    EXPECT_THAT(output, HasSubstr("RP_excl"));
+    EXPECT_TRUE(ReadDistanceMatrix(out + "/distances.bin", 72).ok());
+    auto json = ReadFileToString(out + "/metrics.json");
+    ASSERT_TRUE(json.ok());
+    EXPECT_THAT(*json, HasSubstr("\"method\": \"" + method + "\""));
+    EXPECT_THAT(*json, HasSubstr("\"models_without_features\""));
+  }
+}
+
+TEST_F(EndToEndTest, CliInspectWritesPointsAndPictures) {
+  const std::string out = *dir_ + "/inspect";
+  std::string output;
+  const int code = RunCommand(std::string(MESHSEEK_CLI_PATH) + " inspect " + *dir_ +
+                                  "/bench/models/20.off --method rld --rld_samples 3000 --out " + out,
+                              &output);
+  ASSERT_EQ(code, 0) << output;
+  EXPECT_THAT(output, HasSubstr("level 1:"));
+  for (const std::string file : {"points.ply", "points.png", "depth_images.png"}) {
+    EXPECT_GT(std::filesystem::file_size(out + "/" + file), 100u) << file;
+  }
+  auto ply = ReadFileToString(out + "/points.ply");
+  ASSERT_TRUE(ply.ok());
+  EXPECT_THAT(*ply, HasSubstr("property int level"));
+}
+
 TEST_F(EndToEndTest, CliNamesTheModelAndLineOfABadMeshAndFailsCleanly) {
   const std::string dir = *dir_ + "/bad";
   std::filesystem::create_directories(dir);
