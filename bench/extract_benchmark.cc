@@ -1,11 +1,14 @@
-// Per-model local-feature extraction time, single-threaded.
+// Per-model local-feature extraction time on one core, for every method.
 //
-//   extract_benchmark --models_dir=DIR [--max_models=N] [--scale=E] [--benchmark_...]
+//   extract_benchmark --models_dir=DIR [--max_models=N] [pipeline flags, e.g. --scale=E]
+//                     [--benchmark_filter=...] [--benchmark_format=json]
 //
-// Reads up to N meshes (sorted by file name) from DIR, then times extraction
-// of each on the calling thread. Reported counters: median and 90th
-// percentile milliseconds per model over the set, and the mean vertex count.
-// Without --models_dir it times a built-in lumpy sphere (CI smoke use).
+// Reads up to N meshes (sorted by path) from DIR once, then times extraction
+// of each on the calling thread (OpenCV's own threads off). Counters: median
+// and 90th-percentile milliseconds per model over the set, mean vertices, and
+// local features per model. BM_ExtractRldSamples/N times RLD-SIFT at N
+// resample points (how its cost grows with N_RLD). Without --models_dir, a
+// built-in lumpy sphere is used (a smoke run).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,73 +21,99 @@
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
 
-#include "common/features/dld_sift.h"
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "cli/pipeline_flags.h"
+#include "common/features/local_feature_extractor.h"
 #include "common/geometry/mesh_io.h"
 #include "common/geometry/test_meshes.h"
+
+ABSL_FLAG(std::string, models_dir, "", "folder of meshes to time (recursive)");
+ABSL_FLAG(int, max_models, 20, "time at most this many models (the first by path)");
 
 namespace meshseek {
 namespace {
 
-struct BenchConfig {
-  std::string models_dir;
-  int max_models = 20;
-  double scale = DldSiftOptions().scale;
-};
-
-BenchConfig& Config() {
-  static BenchConfig config;
-  return config;
-}
-
-std::vector<TriangleMesh> LoadModels() {
-  std::vector<TriangleMesh> meshes;
-  const BenchConfig& config = Config();
-  if (config.models_dir.empty()) {
-    meshes.push_back(testing_meshes::Icosphere(5));
-    return meshes;
-  }
-  std::vector<std::string> paths;
-  for (const auto& entry : std::filesystem::recursive_directory_iterator(config.models_dir)) {
-    if (entry.is_regular_file() && MeshFormatFromPath(entry.path().string()).ok()) {
-      paths.push_back(entry.path().string());
+const std::vector<TriangleMesh>& Models() {
+  static const std::vector<TriangleMesh> meshes = [] {
+    std::vector<TriangleMesh> out;
+    const std::string dir = absl::GetFlag(FLAGS_models_dir);
+    if (dir.empty()) {
+      out.push_back(testing_meshes::Icosphere(5));
+      return out;
     }
-  }
-  std::sort(paths.begin(), paths.end());
-  if (static_cast<int>(paths.size()) > config.max_models) paths.resize(config.max_models);
-  for (const std::string& path : paths) {
-    auto mesh = ReadMesh(path);
-    if (!mesh.ok()) {
-      std::cerr << mesh.status() << "\n";
-      std::exit(1);
+    std::vector<std::string> paths;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
+      if (entry.is_regular_file() && MeshFormatFromPath(entry.path().string()).ok()) {
+        paths.push_back(entry.path().string());
+      }
     }
-    meshes.push_back(*std::move(mesh));
-  }
+    std::sort(paths.begin(), paths.end());
+    if (static_cast<int>(paths.size()) > absl::GetFlag(FLAGS_max_models)) {
+      paths.resize(absl::GetFlag(FLAGS_max_models));
+    }
+    for (const std::string& path : paths) {
+      auto mesh = ReadMesh(path);
+      if (!mesh.ok()) {
+        std::cerr << mesh.status() << "\n";
+        std::exit(1);
+      }
+      out.push_back(*std::move(mesh));
+    }
+    return out;
+  }();
   return meshes;
 }
 
-void BM_ExtractDldSift(benchmark::State& state) {
-  static const std::vector<TriangleMesh> meshes = LoadModels();
-  DldSiftOptions options;
-  options.scale = Config().scale;
+ExtractorOptions& BaseOptions() {
+  static ExtractorOptions options;
+  return options;
+}
+
+void TimeExtraction(benchmark::State& state, const ExtractorOptions& options) {
+  const std::vector<TriangleMesh>& meshes = Models();
   std::vector<double> per_model_ms;
-  double vertices = 0;
+  double vertices = 0, features = 0;
   for (const auto& m : meshes) vertices += m.vertices.size();
   for (auto _ : state) {
     for (const TriangleMesh& mesh : meshes) {
       const auto start = std::chrono::steady_clock::now();
-      auto features = ExtractDldSift(mesh, options);
+      auto extracted = ExtractLocalFeatures(mesh, options);
       per_model_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-      benchmark::DoNotOptimize(features);
+      if (!extracted.ok()) {
+        state.SkipWithError(std::string(extracted.status().message()).c_str());
+        return;
+      }
+      features += extracted->size();
     }
   }
   std::sort(per_model_ms.begin(), per_model_ms.end());
   state.counters["models"] = static_cast<double>(meshes.size());
   state.counters["mean_vertices"] = vertices / meshes.size();
+  state.counters["features_per_model"] = features / per_model_ms.size();
   state.counters["median_ms_per_model"] = per_model_ms[per_model_ms.size() / 2];
   state.counters["p90_ms_per_model"] = per_model_ms[per_model_ms.size() * 9 / 10];
 }
-BENCHMARK(BM_ExtractDldSift)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+void BM_Extract(benchmark::State& state, FeatureMethod method) {
+  ExtractorOptions options = BaseOptions();
+  options.method = method;
+  TimeExtraction(state, options);
+}
+BENCHMARK_CAPTURE(BM_Extract, dld, FeatureMethod::kDldSift)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_Extract, ld, FeatureMethod::kLdSift)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_Extract, rld, FeatureMethod::kRldSift)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+void BM_ExtractRldSamples(benchmark::State& state) {
+  ExtractorOptions options = BaseOptions();
+  options.method = FeatureMethod::kRldSift;
+  options.rld.num_samples = static_cast<int>(state.range(0));
+  TimeExtraction(state, options);
+}
+BENCHMARK(BM_ExtractRldSamples)
+    ->Arg(2500)->Arg(5000)->Arg(10000)->Arg(15000)->Arg(30000)
+    ->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
 }  // namespace meshseek
@@ -92,14 +121,13 @@ BENCHMARK(BM_ExtractDldSift)->Unit(benchmark::kMillisecond)->Iterations(1);
 int main(int argc, char** argv) {
   cv::setNumThreads(0);  // one core: no OpenCV worker threads either
   benchmark::Initialize(&argc, argv);
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](const std::string& flag) { return arg.substr(flag.size()); };
-    if (arg.rfind("--models_dir=", 0) == 0) meshseek::Config().models_dir = value("--models_dir=");
-    else if (arg.rfind("--max_models=", 0) == 0) meshseek::Config().max_models = std::atoi(value("--max_models=").c_str());
-    else if (arg.rfind("--scale=", 0) == 0) meshseek::Config().scale = std::atof(value("--scale=").c_str());
-    else { std::cerr << "unknown flag " << arg << "\n"; return 2; }
+  absl::ParseCommandLine(argc, argv);
+  auto options = meshseek::cli::PipelineOptionsFromFlags();
+  if (!options.ok()) {
+    std::cerr << options.status() << "\n";
+    return 2;
   }
+  meshseek::BaseOptions() = options->extractor;
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;
