@@ -33,6 +33,9 @@ ABSL_FLAG(std::string, orientation, "",
 ABSL_FLAG(std::string, depth_to_gray, "",
           "depth to grey mapping: fixed (2s range) | stretch (image range); empty: the method's "
           "default");
+ABSL_FLAG(int, max_orientations, kDld.descriptor.max_orientations,
+          "with --orientation dominant: at most this many descriptors per depth image (0: all "
+          "peaks within 80 % of the highest)");
 ABSL_FLAG(double, blur_sigma, kDld.descriptor.blur_sigma, "SIFT blur sigma in pixels");
 ABSL_FLAG(int, vocabulary, kDefaults.kmeans.num_centroids, "codebook size V (k-means centroids)");
 ABSL_FLAG(int, kmeans_points_per_centroid, kDefaults.kmeans.max_points_per_centroid,
@@ -68,6 +71,7 @@ absl::Status ApplyDescriptorFlags(SiftDescriptorOptions* descriptor) {
         absl::StrCat("--depth_to_gray must be 'fixed' or 'stretch', got '", gray, "'"));
   }
   descriptor->blur_sigma = absl::GetFlag(FLAGS_blur_sigma);
+  descriptor->max_orientations = absl::GetFlag(FLAGS_max_orientations);
   return absl::OkStatus();
 }
 

@@ -9,6 +9,7 @@ void DescriptorToJson(const SiftDescriptorOptions& d, Json* json) {
   json->Set("depth_to_gray", d.depth_to_gray == DepthToGray::kFixedRange ? "fixed_range" : "stretch");
   json->Set("orientation",
             d.orientation == ImageOrientation::kUpAxis ? "up_axis_180_sum" : "dominant_gradient");
+  json->Set("max_orientations", d.max_orientations);
   json->Set("sift_blur_sigma", d.blur_sigma);
 }
 

@@ -12,6 +12,10 @@
 namespace meshseek {
 
 absl::Status SiftDescriptorOptions::Validate() const {
+  if (max_orientations < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_orientations must be >= 0, got ", max_orientations));
+  }
   if (!(blur_sigma >= 0.5 && blur_sigma <= 5)) {
     return absl::InvalidArgumentError(
         absl::StrCat("SIFT blur_sigma must be in [0.5, 5] pixels, got ", blur_sigma));
@@ -85,16 +89,20 @@ std::vector<float> DominantOrientations(const DepthImage& image, float peak_rati
     smooth[b] = (h(b - 2) + h(b + 2)) / 16 + (h(b - 1) + h(b + 1)) * 4 / 16 + h(b) * 6 / 16;
   }
   const float highest = *std::max_element(smooth, smooth + kBins);
-  std::vector<float> angles;
-  if (!(highest > 0)) return angles;
+  std::vector<std::pair<float, float>> peaks;  // (height, angle)
+  if (!(highest > 0)) return {};
   for (int b = 0; b < kBins; ++b) {
     const float left = smooth[(b + kBins - 1) % kBins], right = smooth[(b + 1) % kBins];
     if (smooth[b] > left && smooth[b] > right && smooth[b] >= peak_ratio * highest) {
       const float offset = 0.5f * (left - right) / (left - 2 * smooth[b] + right);
-      float angle = (b + 0.5f + offset) * 360.0f / kBins;
-      angles.push_back(std::fmod(angle + 360.0f, 360.0f));
+      const float angle = (b + 0.5f + offset) * 360.0f / kBins;
+      peaks.emplace_back(smooth[b], std::fmod(angle + 360.0f, 360.0f));
     }
   }
+  std::stable_sort(peaks.begin(), peaks.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<float> angles;
+  for (const auto& peak : peaks) angles.push_back(peak.second);
   return angles;
 }
 
@@ -124,7 +132,12 @@ int DepthSiftDescriber::Describe(const DepthImage& image, std::vector<uint8_t>* 
     impl_->keypoints.emplace_back(centre, centre, keypoint_size, 0.0f);
   } else {
     // OpenCV's keypoint angle is clockwise (image y points down): 360 - theta.
-    for (const float theta : DominantOrientations(image)) {
+    std::vector<float> thetas = DominantOrientations(image);
+    if (impl_->options.max_orientations > 0 &&
+        static_cast<int>(thetas.size()) > impl_->options.max_orientations) {
+      thetas.resize(impl_->options.max_orientations);
+    }
+    for (const float theta : thetas) {
       const float angle = 360.0f - theta;
       impl_->keypoints.emplace_back(centre, centre, keypoint_size, angle >= 360.0f ? 0.0f : angle);
     }

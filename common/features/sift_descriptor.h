@@ -53,6 +53,9 @@ struct SiftDescriptorOptions {
   ImageOrientation orientation = ImageOrientation::kDominant;
   /// Mapping from depth to grey level.
   DepthToGray depth_to_gray = DepthToGray::kFixedRange;
+  /// With kDominant: at most this many orientations (the strongest peaks) per
+  /// image; 0 keeps every peak within 80 % of the highest, as Lowe does.
+  int max_orientations = 0;
   /// Gaussian blur sigma of the image before gradients, in pixels (cv::SIFT's
   /// `sigma`, which assumes the input already carries 0.5 of blur: 0.5 means
   /// no extra blur, as in VLFeat's raw descriptor that LD-SIFT's authors used;
@@ -69,7 +72,7 @@ struct SiftDescriptorOptions {
 // the image's +x axis (y up): peaks of a 36-bin histogram of gradient
 // orientations weighted by magnitude and a centred Gaussian, smoothed, with
 // every local peak within `peak_ratio` of the highest kept and refined by a
-// parabola. Empty for an image without gradient.
+// parabola; strongest first. Empty for an image without gradient.
 std::vector<float> DominantOrientations(const DepthImage& image, float peak_ratio = 0.8f);
 
 // Turns float SIFT bins into SIFT's normalised byte form (in place on `bins`,

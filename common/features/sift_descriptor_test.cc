@@ -150,6 +150,25 @@ TEST(SiftDescriptorTest, DominantOrientationFollowsTheImageRotation) {
   }
 }
 
+TEST(SiftDescriptorTest, OrientationsComeStrongestFirstAndCanBeCapped) {
+  // A bowl (depth rising from the centre in every direction) has gradients
+  // all round: several orientation peaks.
+  DepthImage bowl = RandomSmoothImage(21, 0);
+  for (int r = 0; r < 21; ++r) {
+    for (int c = 0; c < 21; ++c) bowl.at(r, c) = 0.01f * ((r - 10) * (r - 10) + 1.3f * (c - 10) * (c - 10));
+  }
+  const std::vector<float> angles = DominantOrientations(bowl);
+  ASSERT_GE(angles.size(), 2u);
+  SiftDescriptorOptions options;
+  options.orientation = ImageOrientation::kDominant;
+  std::vector<uint8_t> all, capped;
+  EXPECT_EQ(DepthSiftDescriber(options).Describe(bowl, &all), static_cast<int>(angles.size()));
+  options.max_orientations = 1;
+  EXPECT_EQ(DepthSiftDescriber(options).Describe(bowl, &capped), 1);
+  // The one kept is the strongest, i.e. the first of the full set.
+  EXPECT_TRUE(std::equal(capped.begin(), capped.end(), all.begin()));
+}
+
 TEST(NormalizeSiftDescriptorTest, ClipsAndScales) {
   float bins[kSiftDimension] = {};
   bins[0] = 100;  // one dominant bin is clipped at 0.2 then renormalised to 1
