@@ -9,17 +9,17 @@
 // local features per model. BM_ExtractRldSamples/N times RLD-SIFT at N
 // resample points (how its cost grows with N_RLD). Without --models_dir, a
 // built-in lumpy sphere is used (a smoke run).
+#include <benchmark/benchmark.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <benchmark/benchmark.h>
-#include <opencv2/core.hpp>
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
@@ -80,7 +80,8 @@ void TimeExtraction(benchmark::State& state, const ExtractorOptions& options) {
       const auto start = std::chrono::steady_clock::now();
       auto extracted = ExtractLocalFeatures(mesh, options);
       per_model_ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count());
       if (!extracted.ok()) {
         state.SkipWithError(std::string(extracted.status().message()).c_str());
         return;
@@ -101,9 +102,15 @@ void BM_Extract(benchmark::State& state, FeatureMethod method) {
   options.method = method;
   TimeExtraction(state, options);
 }
-BENCHMARK_CAPTURE(BM_Extract, dld, FeatureMethod::kDldSift)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK_CAPTURE(BM_Extract, ld, FeatureMethod::kLdSift)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK_CAPTURE(BM_Extract, rld, FeatureMethod::kRldSift)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_Extract, dld, FeatureMethod::kDldSift)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Extract, ld, FeatureMethod::kLdSift)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_Extract, rld, FeatureMethod::kRldSift)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 void BM_ExtractRldSamples(benchmark::State& state) {
   ExtractorOptions options = BaseOptions();
@@ -112,8 +119,13 @@ void BM_ExtractRldSamples(benchmark::State& state) {
   TimeExtraction(state, options);
 }
 BENCHMARK(BM_ExtractRldSamples)
-    ->Arg(2500)->Arg(5000)->Arg(10000)->Arg(15000)->Arg(30000)
-    ->Unit(benchmark::kMillisecond)->Iterations(1);
+    ->Arg(2500)
+    ->Arg(5000)
+    ->Arg(10000)
+    ->Arg(15000)
+    ->Arg(30000)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 }  // namespace
 }  // namespace meshseek

@@ -11,10 +11,9 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
@@ -25,7 +24,9 @@
 #include "common/pipeline/retrieval_pipeline.h"
 
 ABSL_FLAG(std::string, manifest, "", "CSV manifest id,class,path");
-ABSL_FLAG(std::string, scales, "0.2",
+ABSL_FLAG(std::string,
+          scales,
+          "0.2",
           "comma-separated scales: E for --method dld, C (scale factor) for ld and rld");
 ABSL_FLAG(std::string, vocabularies, "1000", "comma-separated codebook sizes V");
 ABSL_FLAG(std::string, epsilons, "", "comma-separated KL epsilons (default: the shipped one)");
@@ -70,7 +71,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> labels;
   for (const auto& m : *models) labels.push_back(m.label);
 
-  std::printf("tag,scale,V,epsilon,RP_excl_micro,RP_excl_macro,RP_incl_micro,NN_micro,ST_micro,DCG_micro,extract_s\n");
+  std::printf(
+      "tag,scale,V,epsilon,RP_excl_micro,RP_excl_macro,RP_incl_micro,NN_micro,ST_micro,DCG_micro,"
+      "extract_s\n");
   for (double scale : ParseList<double>(absl::GetFlag(FLAGS_scales))) {
     // The method's scale knob: E for DLD-SIFT, C for the scale-space methods.
     options.extractor.dld.scale = scale;
@@ -96,13 +99,22 @@ int main(int argc, char** argv) {
         options.kl.epsilon = eps;
         auto distances = RankCollection(*histograms, options);
         auto metrics = EvaluateRetrieval(labels, *distances, options.num_threads);
-        const std::string row = absl::StrFormat(
-            "%s,%g,%d,%g,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.1f", absl::GetFlag(FLAGS_tag), scale, v, eps,
-            100 * metrics->micro.rp_excl, 100 * metrics->macro.rp_excl, 100 * metrics->micro.rp_incl,
-            100 * metrics->micro.nn, 100 * metrics->micro.second_tier, 100 * metrics->micro.dcg, extract_s);
+        const std::string row = absl::StrFormat("%s,%g,%d,%g,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.1f",
+                                                absl::GetFlag(FLAGS_tag),
+                                                scale,
+                                                v,
+                                                eps,
+                                                100 * metrics->micro.rp_excl,
+                                                100 * metrics->macro.rp_excl,
+                                                100 * metrics->micro.rp_incl,
+                                                100 * metrics->micro.nn,
+                                                100 * metrics->micro.second_tier,
+                                                100 * metrics->micro.dcg,
+                                                extract_s);
         std::printf("%s\n", row.c_str());
         std::fflush(stdout);
-        if (!absl::GetFlag(FLAGS_csv).empty()) std::ofstream(absl::GetFlag(FLAGS_csv), std::ios::app) << row << "\n";
+        if (!absl::GetFlag(FLAGS_csv).empty())
+          std::ofstream(absl::GetFlag(FLAGS_csv), std::ios::app) << row << "\n";
       }
     }
   }

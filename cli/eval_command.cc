@@ -10,7 +10,10 @@
 #include "common/base/status_macros.h"
 #include "common/pipeline/retrieval_pipeline.h"
 
-ABSL_FLAG(std::string, manifest, "", "eval: CSV manifest with columns id,class,path (paths relative to it)");
+ABSL_FLAG(std::string,
+          manifest,
+          "",
+          "eval: CSV manifest with columns id,class,path (paths relative to it)");
 ABSL_FLAG(std::string, out, "", "output folder");
 
 namespace meshseek::cli {
@@ -23,19 +26,31 @@ absl::Status RunEval() {
 
   MESHSEEK_ASSIGN_OR_RETURN(const RetrievalPipelineOptions options, PipelineOptionsFromFlags());
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<ManifestEntry> models, ReadManifest(manifest_path));
-  std::fprintf(stderr, "meshseek eval: %zu models from %s, method %s, %d threads\n", models.size(),
-               manifest_path.c_str(), FeatureMethodName(options.extractor.method),
+  std::fprintf(stderr,
+               "meshseek eval: %zu models from %s, method %s, %d threads\n",
+               models.size(),
+               manifest_path.c_str(),
+               FeatureMethodName(options.extractor.method),
                ResolveThreadCount(options.num_threads));
-  MESHSEEK_ASSIGN_OR_RETURN(const CollectionEvaluation evaluation, EvaluateCollection(models, options));
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionEvaluation evaluation,
+                            EvaluateCollection(models, options));
   MESHSEEK_RETURN_IF_ERROR(WriteEvaluation(evaluation, options, out_dir));
 
   const StageTimings& t = evaluation.timings;
   std::printf("%s", FormatMetricsTable(evaluation.metrics).c_str());
   std::printf("R-precision (query excluded = first tier): %.1f %% micro, %.1f %% macro\n",
-              100 * evaluation.metrics.micro.rp_excl, 100 * evaluation.metrics.macro.rp_excl);
-  std::printf("%zu models, codebook V = %zu; time %.1f s (extract %.1f, codebook %.1f, encode %.1f, rank %.1f)\n",
-              evaluation.models.size(), evaluation.codebook_size, t.total_seconds, t.extract_seconds,
-              t.codebook_seconds, t.encode_seconds, t.rank_seconds);
+              100 * evaluation.metrics.micro.rp_excl,
+              100 * evaluation.metrics.macro.rp_excl);
+  std::printf(
+      "%zu models, codebook V = %zu; time %.1f s (extract %.1f, codebook %.1f, encode %.1f, rank "
+      "%.1f)\n",
+      evaluation.models.size(),
+      evaluation.codebook_size,
+      t.total_seconds,
+      t.extract_seconds,
+      t.codebook_seconds,
+      t.encode_seconds,
+      t.rank_seconds);
   std::printf("wrote %s/distances.bin and %s/metrics.json\n", out_dir.c_str(), out_dir.c_str());
   return absl::OkStatus();
 }

@@ -10,12 +10,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <string>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 #include "absl/flags/declare.h"
 #include "absl/flags/flag.h"
@@ -37,9 +36,14 @@ namespace {
 
 // Level 1, 2, 3, ... -> distinct colours (BGR); level 0 (dense points) red.
 cv::Scalar LevelColour(int level) {
-  static const cv::Scalar kPalette[] = {{40, 40, 230},  {230, 120, 30}, {40, 180, 40},
-                                        {200, 60, 200}, {30, 200, 230}, {200, 200, 40},
-                                        {120, 60, 20},  {90, 90, 90}};
+  static const cv::Scalar kPalette[] = {{40, 40, 230},
+                                        {230, 120, 30},
+                                        {40, 180, 40},
+                                        {200, 60, 200},
+                                        {30, 200, 230},
+                                        {200, 200, 40},
+                                        {120, 60, 20},
+                                        {90, 90, 90}};
   return kPalette[std::min<std::size_t>(std::max(level - 1, 0), std::size(kPalette) - 1)];
 }
 
@@ -75,13 +79,16 @@ cv::Mat ShadeDepth(const DepthImage& image) {
     for (int c = 0; c < image.size; ++c) {
       const float d = image.at(r, c);
       if (d == DepthImage::kEmpty) continue;
-      grey.at<uint8_t>(r, c) = static_cast<uint8_t>(hi > lo ? 235 - 200 * (d - lo) / (hi - lo) : 200);
+      grey.at<uint8_t>(r, c) =
+          static_cast<uint8_t>(hi > lo ? 235 - 200 * (d - lo) / (hi - lo) : 200);
     }
   }
   return grey;
 }
 
-absl::Status WriteOverview(const std::string& path, const TriangleMesh& mesh, const LocalFeatures& features) {
+absl::Status WriteOverview(const std::string& path,
+                           const TriangleMesh& mesh,
+                           const LocalFeatures& features) {
   MESHSEEK_ASSIGN_OR_RETURN(const Sphere sphere, MinimumEnclosingSphere(mesh));
   const PrincipalAxes axes = ComputePrincipalAxes(mesh.vertices);
   const TriangleBvh bvh(mesh);
@@ -101,21 +108,29 @@ absl::Status WriteOverview(const std::string& path, const TriangleMesh& mesh, co
   const double to_pixel = options.image_size / (2 * s);
   for (const Keypoint& k : features.keypoints) {
     const Vec3d d = Vec3d(k.position) - frame.point;
-    const double col = (Dot(d, right) + s) * to_pixel - 0.5, row = (s - Dot(d, frame.up)) * to_pixel - 0.5;
+    const double col = (Dot(d, right) + s) * to_pixel - 0.5,
+                 row = (s - Dot(d, frame.up)) * to_pixel - 0.5;
     const int ci = static_cast<int>(std::lround(col)), ri = static_cast<int>(std::lround(row));
     if (ci < 0 || ri < 0 || ci >= options.image_size || ri >= options.image_size) continue;
     // Visible: not behind the surface the camera sees at that pixel.
     const double depth = s - Dot(d, frame.normal);
     if (view.at(ri, ci) != DepthImage::kEmpty && depth > view.at(ri, ci) + 0.02 * s) continue;
-    cv::circle(canvas, cv::Point(static_cast<int>(col * kZoom), static_cast<int>(row * kZoom)), 2,
-               LevelColour(k.level), cv::FILLED);
+    cv::circle(canvas,
+               cv::Point(static_cast<int>(col * kZoom), static_cast<int>(row * kZoom)),
+               2,
+               LevelColour(k.level),
+               cv::FILLED);
   }
-  if (!cv::imwrite(path, canvas)) return absl::PermissionDeniedError(absl::StrCat(path, ": cannot write"));
+  if (!cv::imwrite(path, canvas))
+    return absl::PermissionDeniedError(absl::StrCat(path, ": cannot write"));
   return absl::OkStatus();
 }
 
-absl::Status WriteMontage(const std::string& path, const TriangleMesh& mesh, const LocalFeatures& features,
-                          const DepthImageOptions& options, int count) {
+absl::Status WriteMontage(const std::string& path,
+                          const TriangleMesh& mesh,
+                          const LocalFeatures& features,
+                          const DepthImageOptions& options,
+                          int count) {
   const TriangleBvh bvh(mesh);
   DepthImageRenderer renderer(mesh, bvh, options);
   const int n = std::min<int>(count, static_cast<int>(features.size()));
@@ -132,9 +147,11 @@ absl::Status WriteMontage(const std::string& path, const TriangleMesh& mesh, con
     cv::resize(ShadeDepth(image), big, cv::Size(), 4, 4, cv::INTER_NEAREST);
     cv::cvtColor(big, colour, cv::COLOR_GRAY2BGR);
     cv::rectangle(colour, cv::Rect(0, 0, colour.cols, colour.rows), LevelColour(k.level), 2);
-    colour.copyTo(montage(cv::Rect((i % columns) * cell + 2, (i / columns) * cell + 2, colour.cols, colour.rows)));
+    colour.copyTo(montage(
+        cv::Rect((i % columns) * cell + 2, (i / columns) * cell + 2, colour.cols, colour.rows)));
   }
-  if (!cv::imwrite(path, montage)) return absl::PermissionDeniedError(absl::StrCat(path, ": cannot write"));
+  if (!cv::imwrite(path, montage))
+    return absl::PermissionDeniedError(absl::StrCat(path, ": cannot write"));
   return absl::OkStatus();
 }
 
@@ -146,19 +163,25 @@ absl::Status RunInspect(const std::string& model_path) {
   MESHSEEK_ASSIGN_OR_RETURN(const RetrievalPipelineOptions options, PipelineOptionsFromFlags());
   MeshReadReport report;
   MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh, ReadMesh(model_path, &report));
-  MESHSEEK_ASSIGN_OR_RETURN(const LocalFeatures features, ExtractLocalFeatures(mesh, options.extractor));
+  MESHSEEK_ASSIGN_OR_RETURN(const LocalFeatures features,
+                            ExtractLocalFeatures(mesh, options.extractor));
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec) return absl::PermissionDeniedError(absl::StrCat(out_dir, ": cannot create folder"));
   MESHSEEK_RETURN_IF_ERROR(WritePointsPly(out_dir + "/points.ply", features));
   MESHSEEK_RETURN_IF_ERROR(WriteOverview(out_dir + "/points.png", mesh, features));
-  MESHSEEK_RETURN_IF_ERROR(WriteMontage(out_dir + "/depth_images.png", mesh, features,
+  MESHSEEK_RETURN_IF_ERROR(WriteMontage(out_dir + "/depth_images.png",
+                                        mesh,
+                                        features,
                                         options.extractor.dld.depth_image,
                                         absl::GetFlag(FLAGS_montage_images)));
   std::map<int, int> per_level;
   for (const Keypoint& k : features.keypoints) per_level[k.level]++;
-  std::printf("%s: %s\n%s: %zu local features", model_path.c_str(), report.Summary().c_str(),
-              FeatureMethodName(options.extractor.method), features.size());
+  std::printf("%s: %s\n%s: %zu local features",
+              model_path.c_str(),
+              report.Summary().c_str(),
+              FeatureMethodName(options.extractor.method),
+              features.size());
   for (const auto& [level, count] : per_level) std::printf(", level %d: %d", level, count);
   std::printf("\nwrote %s/points.ply, points.png and depth_images.png\n", out_dir.c_str());
   return absl::OkStatus();

@@ -8,10 +8,9 @@
 // and handed to the core (common/). See `meshseek --help`.
 #include <cstdio>
 #include <iostream>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"

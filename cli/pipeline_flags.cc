@@ -12,38 +12,60 @@ const meshseek::DldSiftOptions& kDld = kDefaults.extractor.dld;
 const meshseek::RldSiftOptions& kRld = kDefaults.extractor.rld;
 }  // namespace
 
-ABSL_FLAG(std::string, method, "dld",
+ABSL_FLAG(std::string,
+          method,
+          "dld",
           "local feature method: dld (DLD-SIFT, dense) | rld (RLD-SIFT, resampled) | ld (LD-SIFT)");
-ABSL_FLAG(double, scale, kDld.scale,
+ABSL_FLAG(double,
+          scale,
+          kDld.scale,
           "dld: support radius E relative to the minimum enclosing sphere (s = E * D / 2)");
 ABSL_FLAG(int, points, kDld.num_points, "dld: feature points per model (N_DLD)");
-ABSL_FLAG(int, frame_samples, kDld.frame_samples_per_support,
+ABSL_FLAG(int,
+          frame_samples,
+          kDld.frame_samples_per_support,
           "dld: dense surface samples per support disc for the local PCA frame");
 ABSL_FLAG(int, rld_samples, kRld.num_samples, "rld: resample points (N_RLD)");
 ABSL_FLAG(int, rld_neighbors, kRld.neighbors, "rld: k of the k-nearest-neighbour graph");
 ABSL_FLAG(int, levels, kRld.scale_space.levels, "ld, rld: scale-space levels L");
-ABSL_FLAG(double, scale_factor, kRld.scale_space.scale_factor,
+ABSL_FLAG(double,
+          scale_factor,
+          kRld.scale_space.scale_factor,
           "ld, rld: C in the feature scale s = C * d * sqrt(level)");
-ABSL_FLAG(bool, weighted_frame, kDld.weighted_frame,
+ABSL_FLAG(bool,
+          weighted_frame,
+          kDld.weighted_frame,
           "dld, rld: distance-weighted (SHOT-style) PCA frame instead of plain PCA");
 ABSL_FLAG(int, image_size, kDld.depth_image.image_size, "depth image side I in pixels (odd)");
-ABSL_FLAG(std::string, orientation, "",
+ABSL_FLAG(std::string,
+          orientation,
+          "",
           "descriptor rotation: dominant (Lowe's gradient peaks) | up (PCA up axis + 180-degree "
           "sum); empty: the method's default");
-ABSL_FLAG(std::string, depth_to_gray, "",
+ABSL_FLAG(std::string,
+          depth_to_gray,
+          "",
           "depth to grey mapping: fixed (2s range) | stretch (image range); empty: the method's "
           "default");
-ABSL_FLAG(int, max_orientations, kDld.descriptor.max_orientations,
+ABSL_FLAG(int,
+          max_orientations,
+          kDld.descriptor.max_orientations,
           "with --orientation dominant: at most this many descriptors per depth image (0: all "
           "peaks within 80 % of the highest)");
 ABSL_FLAG(double, blur_sigma, kDld.descriptor.blur_sigma, "SIFT blur sigma in pixels");
 ABSL_FLAG(int, vocabulary, kDefaults.kmeans.num_centroids, "codebook size V (k-means centroids)");
-ABSL_FLAG(int, kmeans_points_per_centroid, kDefaults.kmeans.max_points_per_centroid,
+ABSL_FLAG(int,
+          kmeans_points_per_centroid,
+          kDefaults.kmeans.max_points_per_centroid,
           "k-means trains on at most this many sampled local features per centroid");
 ABSL_FLAG(int, kmeans_iterations, kDefaults.kmeans.max_iterations, "maximum k-means iterations");
-ABSL_FLAG(uint64_t, seed, kDefaults.kmeans.seed,
+ABSL_FLAG(uint64_t,
+          seed,
+          kDefaults.kmeans.seed,
           "seed of every random choice (k-means sampling and seeding; synth shapes)");
-ABSL_FLAG(double, kl_epsilon, kDefaults.kl.epsilon,
+ABSL_FLAG(double,
+          kl_epsilon,
+          kDefaults.kl.epsilon,
           "mass added to every histogram bin before KL divergence (zero-bin rule)");
 ABSL_FLAG(int, threads, kDefaults.num_threads, "threads (0: all cores)");
 ABSL_FLAG(bool, progress, true, "show progress bars on stderr");

@@ -10,7 +10,9 @@
 
 ABSL_DECLARE_FLAG(std::string, out);
 ABSL_DECLARE_FLAG(uint64_t, seed);
-ABSL_FLAG(int, models_per_class, meshseek::SyntheticBenchmarkOptions().models_per_class,
+ABSL_FLAG(int,
+          models_per_class,
+          meshseek::SyntheticBenchmarkOptions().models_per_class,
           "synth: models generated per class");
 
 namespace meshseek::cli {
@@ -25,7 +27,8 @@ absl::Status RunSynth() {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   MESHSEEK_RETURN_IF_ERROR(GenerateSyntheticBenchmark(options, out_dir));
   std::printf("wrote the synthetic benchmark (%d models per class, seed %llu) to %s\n",
-              options.models_per_class, static_cast<unsigned long long>(options.seed),
+              options.models_per_class,
+              static_cast<unsigned long long>(options.seed),
               out_dir.c_str());
   return absl::OkStatus();
 }

@@ -1,14 +1,14 @@
 // End to end on the built-in synthetic benchmark: the in-process pipeline, the
 // `meshseek` CLI as a user runs it, and the independent evaluator.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "common/base/file_io.h"
 #include "common/eval/distance_matrix.h"
@@ -81,9 +81,10 @@ TEST_F(EndToEndTest, PipelineRanksSyntheticClassesWellAboveChance) {
 TEST_F(EndToEndTest, CliEvalWritesMatrixAndMetricsThatTheReferenceEvaluatorAgreesWith) {
   const std::string out = *dir_ + "/eval";
   std::string output;
-  const int code = RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest " + *dir_ +
-                           "/bench/manifest.csv --method dld --points 256 --vocabulary 150 --out " + out,
-                       &output);
+  const int code =
+      RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest " + *dir_ +
+                     "/bench/manifest.csv --method dld --points 256 --vocabulary 150 --out " + out,
+                 &output);
   ASSERT_EQ(code, 0) << output;
   EXPECT_THAT(output, HasSubstr("RP_excl"));
   EXPECT_THAT(output, HasSubstr("micro"));
@@ -100,8 +101,9 @@ TEST_F(EndToEndTest, CliEvalWritesMatrixAndMetricsThatTheReferenceEvaluatorAgree
       std::string(std::getenv("MESHSEEK_SOURCE_DIR")) + "/../shared/tools/psb_eval.py";
   if (!std::filesystem::exists(evaluator)) GTEST_SKIP() << evaluator << " not present";
   std::string reference;
-  ASSERT_EQ(RunCommand("python3 " + evaluator + " " + *dir_ + "/bench/manifest.csv " + out + "/distances.bin",
-                &reference),
+  ASSERT_EQ(RunCommand("python3 " + evaluator + " " + *dir_ + "/bench/manifest.csv " + out +
+                           "/distances.bin",
+                       &reference),
             0)
       << reference;
   // psb_eval.py prints the same table as meshseek (one decimal, same layout).
@@ -123,10 +125,11 @@ TEST_F(EndToEndTest, EveryMethodRunsThroughTheCliWithTheSameOutputs) {
   for (const std::string method : {"ld", "rld"}) {
     const std::string out = *dir_ + "/eval_" + method;
     std::string output;
-    const int code = RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --progress=false --manifest " +
-                                    *dir_ + "/bench/manifest.csv --method " + method +
-                                    " --rld_samples 3000 --vocabulary 100 --out " + out,
-                                &output);
+    const int code =
+        RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --progress=false --manifest " + *dir_ +
+                       "/bench/manifest.csv --method " + method +
+                       " --rld_samples 3000 --vocabulary 100 --out " + out,
+                   &output);
     ASSERT_EQ(code, 0) << output;
     EXPECT_THAT(output, HasSubstr("RP_excl"));
     EXPECT_TRUE(ReadDistanceMatrix(out + "/distances.bin", 72).ok());
@@ -140,9 +143,10 @@ TEST_F(EndToEndTest, EveryMethodRunsThroughTheCliWithTheSameOutputs) {
 TEST_F(EndToEndTest, CliInspectWritesPointsAndPictures) {
   const std::string out = *dir_ + "/inspect";
   std::string output;
-  const int code = RunCommand(std::string(MESHSEEK_CLI_PATH) + " inspect " + *dir_ +
-                                  "/bench/models/20.off --method rld --rld_samples 3000 --out " + out,
-                              &output);
+  const int code =
+      RunCommand(std::string(MESHSEEK_CLI_PATH) + " inspect " + *dir_ +
+                     "/bench/models/20.off --method rld --rld_samples 3000 --out " + out,
+                 &output);
   ASSERT_EQ(code, 0) << output;
   EXPECT_THAT(output, HasSubstr("level 1:"));
   for (const std::string file : {"points.ply", "points.png", "depth_images.png"}) {
@@ -160,9 +164,10 @@ TEST_F(EndToEndTest, CliNamesTheModelAndLineOfABadMeshAndFailsCleanly) {
   std::ofstream(dir + "/broken.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
   std::ofstream(dir + "/manifest.csv") << "id,class,path\na,x,ok.off\nb,x,broken.off\nc,x,ok.off\n";
   std::string output;
-  const int code = RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --progress=false --manifest " + dir +
-                           "/manifest.csv --out " + dir + "/out",
-                       &output);
+  const int code =
+      RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --progress=false --manifest " + dir +
+                     "/manifest.csv --out " + dir + "/out",
+                 &output);
   EXPECT_NE(code, 0);
   EXPECT_THAT(output, HasSubstr("model 'b' (manifest line 3)"));
   EXPECT_THAT(output, HasSubstr("broken.off: face 0 (0-based) references vertex 7"));
@@ -174,18 +179,21 @@ TEST_F(EndToEndTest, CliRejectsBadFlagsWithAClearMessage) {
   EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --out /tmp/x", &output), 2);
   EXPECT_THAT(output, HasSubstr("eval needs --manifest FILE"));
   EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest " + *dir_ +
-                    "/bench/manifest.csv --out /tmp/x --method sift3d",
-                &output),
+                           "/bench/manifest.csv --out /tmp/x --method sift3d",
+                       &output),
             2);
   EXPECT_THAT(output, HasSubstr("unknown feature method 'sift3d'"));
   EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest " + *dir_ +
-                    "/bench/manifest.csv --out /tmp/x --scale -1",
-                &output),
+                           "/bench/manifest.csv --out /tmp/x --scale -1",
+                       &output),
             2);
   EXPECT_THAT(output, HasSubstr("scale E must be in (0, 2], got -1"));
   EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " frobnicate", &output), 2);
   EXPECT_THAT(output, HasSubstr("unknown command 'frobnicate'"));
-  EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest /nonexistent.csv --out /tmp/x", &output), 1);
+  EXPECT_EQ(
+      RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest /nonexistent.csv --out /tmp/x",
+                 &output),
+      1);
   EXPECT_THAT(output, HasSubstr("/nonexistent.csv"));
 }
 

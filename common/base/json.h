@@ -29,8 +29,16 @@ class Json {
   Json(const char* s) : value_(std::string(s)) {}
   Json(std::string s) : value_(std::move(s)) {}
 
-  static Json MakeObject() { Json j; j.value_ = Object{}; return j; }
-  static Json MakeArray() { Json j; j.value_ = Array{}; return j; }
+  static Json MakeObject() {
+    Json j;
+    j.value_ = Object{};
+    return j;
+  }
+  static Json MakeArray() {
+    Json j;
+    j.value_ = Array{};
+    return j;
+  }
 
   // Object member (replaces an existing key). The value must be an object.
   Json& Set(const std::string& key, Json value);

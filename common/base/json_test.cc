@@ -1,8 +1,8 @@
 #include "common/base/json.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace meshseek {
 namespace {

@@ -18,8 +18,8 @@ namespace internal {
 
 LogMessage::LogMessage(LogLevel level, const char* file, int line) : level_(level) {
   const char* base = std::strrchr(file, '/');
-  stream_ << kLevelNames[static_cast<int>(level)] << ' ' << (base ? base + 1 : file) << ':'
-          << line << "] ";
+  stream_ << kLevelNames[static_cast<int>(level)] << ' ' << (base ? base + 1 : file) << ':' << line
+          << "] ";
 }
 
 LogMessage::~LogMessage() {

@@ -47,12 +47,11 @@ struct LogVoidify {
 #define MESHSEEK_LOG_LEVEL_ERROR ::meshseek::LogLevel::kError
 #define MESHSEEK_LOG_LEVEL_FATAL ::meshseek::LogLevel::kFatal
 
-#define MESHSEEK_LOG(severity)                                      \
-  (MESHSEEK_LOG_LEVEL_##severity < ::meshseek::MinLogLevel())       \
-      ? (void)0                                                     \
-      : ::meshseek::internal::LogVoidify() &                        \
-            ::meshseek::internal::LogMessage(                       \
-                MESHSEEK_LOG_LEVEL_##severity, __FILE__, __LINE__)  \
+#define MESHSEEK_LOG(severity)                                                                  \
+  (MESHSEEK_LOG_LEVEL_##severity < ::meshseek::MinLogLevel())                                   \
+      ? (void)0                                                                                 \
+      : ::meshseek::internal::LogVoidify() &                                                    \
+            ::meshseek::internal::LogMessage(MESHSEEK_LOG_LEVEL_##severity, __FILE__, __LINE__) \
                 .stream()
 
 #endif  // MESHSEEK_COMMON_BASE_LOGGING_H_

@@ -59,15 +59,20 @@ void ProgressBar::Draw(bool final_line) {
   const double rate = elapsed > 0 ? done_ / elapsed : 0.0;
   std::string line;
   if (final_line) {
-    line = absl::StrFormat("%s: %d/%d done in %s (%.1f/s)", label_, done_, total_,
-                           FormatDuration(elapsed), rate);
+    line = absl::StrFormat(
+        "%s: %d/%d done in %s (%.1f/s)", label_, done_, total_, FormatDuration(elapsed), rate);
   } else {
     constexpr int kWidth = 30;
     const double frac = total_ == 0 ? 1.0 : static_cast<double>(done_) / total_;
     const int filled = static_cast<int>(frac * kWidth);
     const double left = rate > 0 ? (total_ - done_) / rate : NAN;
-    line = absl::StrFormat("%s [%s%s] %d/%d %.1f/s, %s left", label_, std::string(filled, '#'),
-                           std::string(kWidth - filled, '.'), done_, total_, rate,
+    line = absl::StrFormat("%s [%s%s] %d/%d %.1f/s, %s left",
+                           label_,
+                           std::string(filled, '#'),
+                           std::string(kWidth - filled, '.'),
+                           done_,
+                           total_,
+                           rate,
                            FormatDuration(left));
   }
   if (tty_) {

@@ -21,8 +21,7 @@
 // `MESHSEEK_ASSIGN_OR_RETURN(auto x, F());` declares/assigns `x` from the
 // StatusOr returned by F(), or returns its status from the enclosing function.
 #define MESHSEEK_ASSIGN_OR_RETURN(lhs, expr) \
-  MESHSEEK_ASSIGN_OR_RETURN_IMPL_(           \
-      MESHSEEK_STATUS_CONCAT_(_meshseek_statusor_, __LINE__), lhs, expr)
+  MESHSEEK_ASSIGN_OR_RETURN_IMPL_(MESHSEEK_STATUS_CONCAT_(_meshseek_statusor_, __LINE__), lhs, expr)
 
 #define MESHSEEK_ASSIGN_OR_RETURN_IMPL_(statusor, lhs, expr) \
   auto statusor = (expr);                                    \

@@ -1,9 +1,9 @@
 // GoogleTest main shared by every meshseek test: seeds the global random
 // generators before each test (COLMAP's convention) so a test never depends on
 // what ran before it, and quiets info logging.
-#include <cstdlib>
-
 #include <gtest/gtest.h>
+
+#include <cstdlib>
 #include <opencv2/core.hpp>
 
 #include "common/base/logging.h"

@@ -106,8 +106,7 @@ TEST(CodebookTest, TrainLearnsTheRequestedVocabulary) {
 
   options.num_centroids = 3000;
   EXPECT_THAT(
-      std::string(
-          Codebook::Train(descriptors.data(), 2000, kDim, options).status().message()),
+      std::string(Codebook::Train(descriptors.data(), 2000, kDim, options).status().message()),
       HasSubstr("got 2000 training points for 3000 centroids"));
 }
 

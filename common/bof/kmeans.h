@@ -45,7 +45,6 @@
 
 namespace meshseek {
 
-
 struct KMeansOptions {
   /// Number of centroids k, i.e. the vocabulary size V (DESIGN.md 2.7: 500..5,000).
   int num_centroids = 1000;

@@ -8,8 +8,8 @@
 #include <limits>
 
 #include "absl/strings/str_cat.h"
-#include "common/base/status_macros.h"
 #include "common/base/file_io.h"
+#include "common/base/status_macros.h"
 
 namespace meshseek {
 namespace {

@@ -9,8 +9,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
-#include "common/base/status_macros.h"
 #include "common/base/file_io.h"
+#include "common/base/status_macros.h"
 
 namespace meshseek {
 namespace {

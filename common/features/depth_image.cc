@@ -15,12 +15,10 @@ absl::Status DepthImageOptions::Validate() const {
   return absl::OkStatus();
 }
 
-DepthImageRenderer::DepthImageRenderer(const TriangleMesh& mesh, const TriangleBvh& bvh,
+DepthImageRenderer::DepthImageRenderer(const TriangleMesh& mesh,
+                                       const TriangleBvh& bvh,
                                        const DepthImageOptions& options)
-    : mesh_(mesh),
-      bvh_(bvh),
-      options_(options),
-      projected_(mesh.vertices.size()) {}
+    : mesh_(mesh), bvh_(bvh), options_(options), projected_(mesh.vertices.size()) {}
 
 void DepthImageRenderer::RenderPair(const ViewFrame& frame, DepthImage* front, DepthImage* back) {
   const int size = options_.image_size;
@@ -125,8 +123,8 @@ bool FinishDepthImage(DepthImage* image) {
     if (d == DepthImage::kEmpty) d = deepest;
   }
   const int c = image->size / 2;
-  image->at(c, c) =
-      0.25f * (image->at(c - 1, c) + image->at(c + 1, c) + image->at(c, c - 1) + image->at(c, c + 1));
+  image->at(c, c) = 0.25f * (image->at(c - 1, c) + image->at(c + 1, c) + image->at(c, c - 1) +
+                             image->at(c, c + 1));
   return true;
 }
 

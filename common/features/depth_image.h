@@ -67,7 +67,8 @@ struct ViewFrame {
 // per thread; the mesh and BVH must outlive it.
 class DepthImageRenderer {
  public:
-  DepthImageRenderer(const TriangleMesh& mesh, const TriangleBvh& bvh,
+  DepthImageRenderer(const TriangleMesh& mesh,
+                     const TriangleBvh& bvh,
                      const DepthImageOptions& options);
 
   // Renders the front and back images of `frame` (raw: empty pixels are

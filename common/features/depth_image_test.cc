@@ -1,8 +1,8 @@
 #include "common/features/depth_image.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "common/geometry/test_meshes.h"
 
@@ -77,7 +77,8 @@ TEST(DepthImageTest, OnlyTheSupportCubeIsDrawn) {
 TEST(DepthImageTest, InvariantUnderRigidMotionAndScale) {
   TriangleMesh mesh = Icosphere(4, 1.0f);
   for (Vec3f& v : mesh.vertices) v.z *= 0.6f + 0.3f * v.x;  // something without symmetry
-  const Vec3d p(mesh.vertices[7]), up = Normalized(Vec3d(1, 2, 0)), n = Normalized(Cross(up, Vec3d(0, 0, 1)));
+  const Vec3d p(mesh.vertices[7]), up = Normalized(Vec3d(1, 2, 0)),
+                                   n = Normalized(Cross(up, Vec3d(0, 0, 1)));
   DepthImage a, b, a2, b2;
   {
     const TriangleBvh bvh(mesh);
@@ -88,7 +89,8 @@ TEST(DepthImageTest, InvariantUnderRigidMotionAndScale) {
   const double scale = 3.5;
   const Vec3d t(10, -4, 2);
   auto apply = [&](const Vec3d& v) {
-    return Vec3d(R[0] * v.x + R[1] * v.y + R[2] * v.z, R[3] * v.x + R[4] * v.y + R[5] * v.z,
+    return Vec3d(R[0] * v.x + R[1] * v.y + R[2] * v.z,
+                 R[3] * v.x + R[4] * v.y + R[5] * v.z,
                  R[6] * v.x + R[7] * v.y + R[8] * v.z);
   };
   TransformMesh(R, scale, t, &mesh);

@@ -18,7 +18,8 @@ absl::Status DldSiftOptions::Validate() const {
         absl::StrCat("DLD-SIFT num_points must be in [1, 1000000], got ", num_points));
   }
   if (!(scale > 0) || scale > 2) {
-    return absl::InvalidArgumentError(absl::StrCat("DLD-SIFT scale E must be in (0, 2], got ", scale));
+    return absl::InvalidArgumentError(
+        absl::StrCat("DLD-SIFT scale E must be in (0, 2], got ", scale));
   }
   if (frame_samples_per_support < 8) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -27,13 +28,16 @@ absl::Status DldSiftOptions::Validate() const {
   if (min_frame_samples < 16 || max_frame_samples < min_frame_samples) {
     return absl::InvalidArgumentError(
         absl::StrCat("DLD-SIFT frame sample bounds must satisfy 16 <= min <= max, got min ",
-                     min_frame_samples, ", max ", max_frame_samples));
+                     min_frame_samples,
+                     ", max ",
+                     max_frame_samples));
   }
   MESHSEEK_RETURN_IF_ERROR(depth_image.Validate());
   return descriptor.Validate();
 }
 
-absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh, const DldSiftOptions& options) {
+absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh,
+                                             const DldSiftOptions& options) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));
   MESHSEEK_ASSIGN_OR_RETURN(const Sphere sphere, MinimumEnclosingSphere(mesh));
@@ -45,8 +49,8 @@ absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh, const Dld
 
   const double area = SurfaceArea(mesh);
   const double wanted = options.frame_samples_per_support * area / (M_PI * s * s);
-  const int64_t frame_count = static_cast<int64_t>(std::clamp<double>(
-      std::ceil(wanted), options.min_frame_samples, options.max_frame_samples));
+  const int64_t frame_count = static_cast<int64_t>(
+      std::clamp<double>(std::ceil(wanted), options.min_frame_samples, options.max_frame_samples));
   MESHSEEK_ASSIGN_OR_RETURN(const SurfacePoints dense, SampleSurface(mesh, frame_count));
   const PointGrid grid(dense.positions, static_cast<float>(s));
   LocalDepthSift describer(mesh, options.depth_image, options.descriptor);
@@ -58,7 +62,8 @@ absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh, const Dld
   for (const Vec3f& p : centres.positions) {
     const auto axes = SupportAxes(dense.positions, grid, p, s, options.weighted_frame, &support);
     if (!axes) continue;
-    describer.Describe({Vec3d(p), axes->axes[0], axes->axes[2], s}, options.two_views, 0, &features);
+    describer.Describe(
+        {Vec3d(p), axes->axes[0], axes->axes[2], s}, options.two_views, 0, &features);
   }
   if (features.keypoints.empty()) {
     return absl::InvalidArgumentError("DLD-SIFT found no usable feature point on the model");

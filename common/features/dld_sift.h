@@ -62,7 +62,8 @@ struct DldSiftOptions {
 
 // Extracts DLD-SIFT features. The mesh must be valid (ValidateMesh), which is
 // checked. Errors name the problem (e.g. a degenerate model).
-absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh, const DldSiftOptions& options);
+absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh,
+                                             const DldSiftOptions& options);
 
 }  // namespace meshseek
 

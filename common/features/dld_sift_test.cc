@@ -1,9 +1,9 @@
 #include "common/features/dld_sift.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <gtest/gtest.h>
 
 #include "common/geometry/test_meshes.h"
 

@@ -15,7 +15,8 @@ absl::Status LdSiftOptions::Validate() const {
   return descriptor.Validate();
 }
 
-absl::StatusOr<LocalFeatures> ExtractLdSift(const TriangleMesh& mesh, const LdSiftOptions& options,
+absl::StatusOr<LocalFeatures> ExtractLdSift(const TriangleMesh& mesh,
+                                            const LdSiftOptions& options,
                                             std::vector<InterestPoint>* detected) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));

@@ -46,7 +46,8 @@ struct LdSiftOptions {
 // are in each keypoint). A model on which nothing is detected gives an empty
 // set, not an error: that is LD-SIFT's documented weakness on sparse meshes
 // and soups.
-absl::StatusOr<LocalFeatures> ExtractLdSift(const TriangleMesh& mesh, const LdSiftOptions& options,
+absl::StatusOr<LocalFeatures> ExtractLdSift(const TriangleMesh& mesh,
+                                            const LdSiftOptions& options,
                                             std::vector<InterestPoint>* detected = nullptr);
 
 }  // namespace meshseek

@@ -2,8 +2,11 @@
 
 namespace meshseek {
 
-std::optional<PrincipalAxes> SupportAxes(const std::vector<Vec3f>& points, const PointGrid& grid,
-                                         const Vec3f& p, double s, bool weighted,
+std::optional<PrincipalAxes> SupportAxes(const std::vector<Vec3f>& points,
+                                         const PointGrid& grid,
+                                         const Vec3f& p,
+                                         double s,
+                                         bool weighted,
                                          std::vector<uint32_t>* scratch) {
   scratch->clear();
   grid.RadiusQuery(p, static_cast<float>(s), scratch);
@@ -12,11 +15,14 @@ std::optional<PrincipalAxes> SupportAxes(const std::vector<Vec3f>& points, const
                   : ComputePrincipalAxes(points, scratch);
 }
 
-LocalDepthSift::LocalDepthSift(const TriangleMesh& mesh, const DepthImageOptions& image_options,
+LocalDepthSift::LocalDepthSift(const TriangleMesh& mesh,
+                               const DepthImageOptions& image_options,
                                const SiftDescriptorOptions& descriptor_options)
     : bvh_(mesh), renderer_(mesh, bvh_, image_options), describer_(descriptor_options) {}
 
-void LocalDepthSift::Describe(const ViewFrame& frame, bool two_views, int level,
+void LocalDepthSift::Describe(const ViewFrame& frame,
+                              bool two_views,
+                              int level,
                               LocalFeatures* out) {
   renderer_.RenderPair(frame, &front_, two_views ? &back_ : nullptr);
   for (int view = 0; view < (two_views ? 2 : 1); ++view) {
@@ -25,8 +31,8 @@ void LocalDepthSift::Describe(const ViewFrame& frame, bool two_views, int level,
     const int described = describer_.Describe(image, &out->descriptors);
     const Vec3f forward(view == 0 ? -frame.normal : frame.normal);
     for (int k = 0; k < described; ++k) {
-      out->keypoints.push_back({Vec3f(frame.point), forward, Vec3f(frame.up),
-                                static_cast<float>(frame.radius), level});
+      out->keypoints.push_back(
+          {Vec3f(frame.point), forward, Vec3f(frame.up), static_cast<float>(frame.radius), level});
     }
   }
 }

@@ -23,15 +23,19 @@ namespace meshseek {
 // indexes `points`), or nullopt if fewer than 3 lie there: such a point yields
 // no feature. `weighted`: SHOT-style (s - distance) weights about p instead of
 // plain PCA about the centroid. `scratch` holds the support between calls.
-std::optional<PrincipalAxes> SupportAxes(const std::vector<Vec3f>& points, const PointGrid& grid,
-                                         const Vec3f& p, double s, bool weighted,
+std::optional<PrincipalAxes> SupportAxes(const std::vector<Vec3f>& points,
+                                         const PointGrid& grid,
+                                         const Vec3f& p,
+                                         double s,
+                                         bool weighted,
                                          std::vector<uint32_t>* scratch);
 
 // Renders and describes local depth images of one mesh. Holds the mesh's BVH
 // and OpenCV state: one per thread and model; the mesh must outlive it.
 class LocalDepthSift {
  public:
-  LocalDepthSift(const TriangleMesh& mesh, const DepthImageOptions& image_options,
+  LocalDepthSift(const TriangleMesh& mesh,
+                 const DepthImageOptions& image_options,
                  const SiftDescriptorOptions& descriptor_options);
 
   // Appends the features of the front view of `frame` (camera at p + s n

@@ -6,7 +6,8 @@ namespace meshseek {
 namespace {
 
 void DescriptorToJson(const SiftDescriptorOptions& d, Json* json) {
-  json->Set("depth_to_gray", d.depth_to_gray == DepthToGray::kFixedRange ? "fixed_range" : "stretch");
+  json->Set("depth_to_gray",
+            d.depth_to_gray == DepthToGray::kFixedRange ? "fixed_range" : "stretch");
   json->Set("orientation",
             d.orientation == ImageOrientation::kUpAxis ? "up_axis_180_sum" : "dominant_gradient");
   json->Set("max_orientations", d.max_orientations);
@@ -31,18 +32,24 @@ absl::StatusOr<FeatureMethod> ParseFeatureMethod(absl::string_view name) {
 
 const char* FeatureMethodName(FeatureMethod method) {
   switch (method) {
-    case FeatureMethod::kDldSift: return "dld";
-    case FeatureMethod::kLdSift: return "ld";
-    case FeatureMethod::kRldSift: return "rld";
+    case FeatureMethod::kDldSift:
+      return "dld";
+    case FeatureMethod::kLdSift:
+      return "ld";
+    case FeatureMethod::kRldSift:
+      return "rld";
   }
   return "?";
 }
 
 absl::Status ExtractorOptions::Validate() const {
   switch (method) {
-    case FeatureMethod::kDldSift: return dld.Validate();
-    case FeatureMethod::kLdSift: return ld.Validate();
-    case FeatureMethod::kRldSift: return rld.Validate();
+    case FeatureMethod::kDldSift:
+      return dld.Validate();
+    case FeatureMethod::kLdSift:
+      return ld.Validate();
+    case FeatureMethod::kRldSift:
+      return rld.Validate();
   }
   return absl::InvalidArgumentError("unknown feature method");
 }
@@ -84,9 +91,12 @@ Json ExtractorOptions::ToJson() const {
 absl::StatusOr<LocalFeatures> ExtractLocalFeatures(const TriangleMesh& mesh,
                                                    const ExtractorOptions& options) {
   switch (options.method) {
-    case FeatureMethod::kDldSift: return ExtractDldSift(mesh, options.dld);
-    case FeatureMethod::kLdSift: return ExtractLdSift(mesh, options.ld);
-    case FeatureMethod::kRldSift: return ExtractRldSift(mesh, options.rld);
+    case FeatureMethod::kDldSift:
+      return ExtractDldSift(mesh, options.dld);
+    case FeatureMethod::kLdSift:
+      return ExtractLdSift(mesh, options.ld);
+    case FeatureMethod::kRldSift:
+      return ExtractRldSift(mesh, options.rld);
   }
   return absl::InvalidArgumentError("unknown feature method");
 }

@@ -14,10 +14,10 @@ namespace meshseek {
 
 struct Keypoint {
   Vec3f position;
-  Vec3f view;    // unit direction the camera looks along
-  Vec3f up;      // unit up axis of the image
-  float scale;   // support radius s, model units
-  int level;     // scale-space level of a detected point; 0 for dense points
+  Vec3f view;   // unit direction the camera looks along
+  Vec3f up;     // unit up axis of the image
+  float scale;  // support radius s, model units
+  int level;    // scale-space level of a detected point; 0 for dense points
 };
 
 struct LocalFeatures {

@@ -24,7 +24,8 @@ absl::Status RldSiftOptions::Validate() const {
   return descriptor.Validate();
 }
 
-absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh, const RldSiftOptions& options,
+absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh,
+                                             const RldSiftOptions& options,
                                              SurfacePoints* resampled,
                                              std::vector<InterestPoint>* detected) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
@@ -46,8 +47,10 @@ absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh, const Rld
       const auto axes =
           SupportAxes(samples.positions, grid, p, ip.scale, options.weighted_frame, &support);
       if (!axes) continue;
-      describer.Describe({Vec3d(p), axes->axes[0], axes->axes[2], ip.scale}, options.two_views,
-                         ip.level, &features);
+      describer.Describe({Vec3d(p), axes->axes[0], axes->axes[2], ip.scale},
+                         options.two_views,
+                         ip.level,
+                         &features);
     }
   }
   if (resampled != nullptr) *resampled = std::move(samples);

@@ -44,7 +44,8 @@ struct RldSiftOptions {
 // Extracts RLD-SIFT features. `resampled` and `detected`, if given, receive
 // the resample points and the interest points (vertex = resample index). A
 // model with no interest point gives an empty set, not an error.
-absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh, const RldSiftOptions& options,
+absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh,
+                                             const RldSiftOptions& options,
                                              SurfacePoints* resampled = nullptr,
                                              std::vector<InterestPoint>* detected = nullptr);
 

@@ -2,10 +2,10 @@
 // RLD-SIFT (resampled graph).
 #include "common/features/rld_sift.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <gtest/gtest.h>
 
 #include "common/features/ld_sift.h"
 #include "common/geometry/test_meshes.h"
@@ -117,7 +117,9 @@ void ExpectInvariance(const Extract& extract) {
     const Vec3d p(a.keypoints[i].position);
     const Vec3d q = Vec3d(rotation[0] * p.x + rotation[1] * p.y + rotation[2] * p.z,
                           rotation[3] * p.x + rotation[4] * p.y + rotation[5] * p.z,
-                          rotation[6] * p.x + rotation[7] * p.y + rotation[8] * p.z) * scale + shift;
+                          rotation[6] * p.x + rotation[7] * p.y + rotation[8] * p.z) *
+                        scale +
+                    shift;
     double best = 1e30;
     for (std::size_t j = 0; j < b.size(); ++j) {
       if (Distance(Vec3d(b.keypoints[j].position), q) < 1e-3 * scale) {

@@ -1,11 +1,11 @@
 #include "common/features/scale_space.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "common/geometry/mesh_vertex_graph.h"
 #include "common/geometry/test_meshes.h"
@@ -44,14 +44,17 @@ TEST(ScaleSpaceTest, FiresOnABumpAtALevelThatGrowsWithItsSize) {
     ASSERT_FALSE(points.empty());
     // The detected point nearest the bump's apex.
     auto angle_to_pole = [&](const InterestPoint& p) {
-      return std::acos(std::clamp(Dot(Normalized(Vec3d(g.graph.positions[p.vertex])), pole), -1.0, 1.0));
+      return std::acos(
+          std::clamp(Dot(Normalized(Vec3d(g.graph.positions[p.vertex])), pole), -1.0, 1.0));
     };
-    const InterestPoint best = *std::min_element(points.begin(), points.end(), [&](const auto& a, const auto& b) {
-      return angle_to_pole(a) < angle_to_pole(b);
-    });
+    const InterestPoint best =
+        *std::min_element(points.begin(), points.end(), [&](const auto& a, const auto& b) {
+          return angle_to_pole(a) < angle_to_pole(b);
+        });
     EXPECT_LT(angle_to_pole(best), 0.25 * width) << "bump width " << width;
     EXPECT_GT(best.level, previous_level) << "bump width " << width;
-    EXPECT_NEAR(best.scale, 5.0 * g.graph.MeanEdgeLength(best.vertex) * std::sqrt(best.level), 1e-4);
+    EXPECT_NEAR(
+        best.scale, 5.0 * g.graph.MeanEdgeLength(best.vertex) * std::sqrt(best.level), 1e-4);
     previous_level = best.level;
   }
 }
@@ -76,7 +79,9 @@ TEST(ScaleSpaceTest, OutputDoesNotDependOnVertexOrder) {
   ASSERT_EQ(a.size(), b.size());
   ASSERT_GT(a.size(), 10u);
   for (InterestPoint& p : a) p.vertex = perm[p.vertex];
-  auto by_vertex = [](const InterestPoint& x, const InterestPoint& y) { return x.vertex < y.vertex; };
+  auto by_vertex = [](const InterestPoint& x, const InterestPoint& y) {
+    return x.vertex < y.vertex;
+  };
   std::sort(a.begin(), a.end(), by_vertex);
   for (std::size_t k = 0; k < a.size(); ++k) {
     EXPECT_EQ(a[k].vertex, b[k].vertex);

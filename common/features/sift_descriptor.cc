@@ -2,10 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 
@@ -99,8 +98,8 @@ std::vector<float> DominantOrientations(const DepthImage& image, float peak_rati
       peaks.emplace_back(smooth[b], std::fmod(angle + 360.0f, 360.0f));
     }
   }
-  std::stable_sort(peaks.begin(), peaks.end(),
-                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::stable_sort(
+      peaks.begin(), peaks.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   std::vector<float> angles;
   for (const auto& peak : peaks) angles.push_back(peak.second);
   return angles;
@@ -142,7 +141,8 @@ int DepthSiftDescriber::Describe(const DepthImage& image, std::vector<uint8_t>* 
       impl_->keypoints.emplace_back(centre, centre, keypoint_size, angle >= 360.0f ? 0.0f : angle);
     }
     // A flat image has no orientation; describe it upright (all zeros anyway).
-    if (impl_->keypoints.empty()) impl_->keypoints.emplace_back(centre, centre, keypoint_size, 0.0f);
+    if (impl_->keypoints.empty())
+      impl_->keypoints.emplace_back(centre, centre, keypoint_size, 0.0f);
   }
   impl_->sift->compute(gray, impl_->keypoints, impl_->descriptors);
   if (impl_->descriptors.cols != kSiftDimension) return 0;
@@ -150,7 +150,8 @@ int DepthSiftDescriber::Describe(const DepthImage& image, std::vector<uint8_t>* 
   for (int row = 0; row < impl_->descriptors.rows; ++row) {
     const float* raw = impl_->descriptors.ptr<float>(row);
     const bool sum_turned = up_axis && impl_->options.symmetrize_180;
-    for (int k = 0; k < kSiftDimension; ++k) bins[k] = raw[k] + (sum_turned ? raw[Rotate180Index(k)] : 0.0f);
+    for (int k = 0; k < kSiftDimension; ++k)
+      bins[k] = raw[k] + (sum_turned ? raw[Rotate180Index(k)] : 0.0f);
     const std::size_t at = out->size();
     out->resize(at + kSiftDimension);
     NormalizeSiftDescriptor(bins, out->data() + at);

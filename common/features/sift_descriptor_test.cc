@@ -1,11 +1,11 @@
 #include "common/features/sift_descriptor.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
-
-#include <gtest/gtest.h>
 
 namespace meshseek {
 namespace {
@@ -20,7 +20,8 @@ DepthImage RandomSmoothImage(int size, uint32_t seed) {
   for (int r = 0; r < size; ++r) {
     for (int col = 0; col < size; ++col) {
       const double x = (col - size / 2) / double(size), y = (r - size / 2) / double(size);
-      image.at(r, col) = static_cast<float>(1 + 0.5 * std::sin(c * x + a) * std::cos(3 * y + b) + 0.3 * x * y);
+      image.at(r, col) =
+          static_cast<float>(1 + 0.5 * std::sin(c * x + a) * std::cos(3 * y + b) + 0.3 * x * y);
     }
   }
   return image;
@@ -155,7 +156,8 @@ TEST(SiftDescriptorTest, OrientationsComeStrongestFirstAndCanBeCapped) {
   // all round: several orientation peaks.
   DepthImage bowl = RandomSmoothImage(21, 0);
   for (int r = 0; r < 21; ++r) {
-    for (int c = 0; c < 21; ++c) bowl.at(r, c) = 0.01f * ((r - 10) * (r - 10) + 1.3f * (c - 10) * (c - 10));
+    for (int c = 0; c < 21; ++c)
+      bowl.at(r, c) = 0.01f * ((r - 10) * (r - 10) + 1.3f * (c - 10) * (c - 10));
   }
   const std::vector<float> angles = DominantOrientations(bowl);
   ASSERT_GE(angles.size(), 2u);

@@ -17,9 +17,7 @@ bool Contains(const Sphere& s, const Vec3d& p) {
   return SquaredDistance(s.center, p) <= r * r;
 }
 
-Sphere FromTwo(const Vec3d& a, const Vec3d& b) {
-  return {(a + b) * 0.5, 0.5 * Distance(a, b)};
-}
+Sphere FromTwo(const Vec3d& a, const Vec3d& b) { return {(a + b) * 0.5, 0.5 * Distance(a, b)}; }
 
 Sphere SmallestContaining(std::initializer_list<Sphere> candidates,
                           std::initializer_list<Vec3d> points) {
@@ -65,7 +63,10 @@ Sphere FromFour(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) 
 
 // Welzl's recursion unrolled into its four levels: sphere of pts[0..n) with
 // the given points on the boundary.
-Sphere WithThree(const std::vector<Vec3d>& pts, std::size_t n, const Vec3d& q1, const Vec3d& q2,
+Sphere WithThree(const std::vector<Vec3d>& pts,
+                 std::size_t n,
+                 const Vec3d& q1,
+                 const Vec3d& q2,
                  const Vec3d& q3) {
   Sphere s = FromThree(q1, q2, q3);
   for (std::size_t i = 0; i < n; ++i) {

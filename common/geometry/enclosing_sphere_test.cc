@@ -1,9 +1,9 @@
 #include "common/geometry/enclosing_sphere.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "common/geometry/test_meshes.h"
 
@@ -30,8 +30,8 @@ double BruteForceRadius(const std::vector<Vec3f>& pts) {
         const Vec3d c(pts[k]);
         const Vec3d ab = b - a, ac = c - a, nn = Cross(ab, ac);
         if (SquaredNorm(nn) > 1e-20) {
-          const Vec3d o =
-              (Cross(nn, ab) * SquaredNorm(ac) + Cross(ac, nn) * SquaredNorm(ab)) / (2 * SquaredNorm(nn));
+          const Vec3d o = (Cross(nn, ab) * SquaredNorm(ac) + Cross(ac, nn) * SquaredNorm(ab)) /
+                          (2 * SquaredNorm(nn));
           check(a + o, Norm(o));
         }
         for (std::size_t l = k + 1; l < n; ++l) {
@@ -39,7 +39,8 @@ double BruteForceRadius(const std::vector<Vec3f>& pts) {
           const double det = 2 * Dot(ab, Cross(ac, w));
           if (std::abs(det) < 1e-12) continue;
           const Vec3d o = (Cross(ac, w) * SquaredNorm(ab) + Cross(w, ab) * SquaredNorm(ac) +
-                           Cross(ab, ac) * SquaredNorm(w)) / det;
+                           Cross(ab, ac) * SquaredNorm(w)) /
+                          det;
           check(a + o, Norm(o));
         }
       }

@@ -77,17 +77,23 @@ absl::Status ValidateMesh(const TriangleMesh& mesh) {
   }
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
     if (!IsFinite(mesh.vertices[v])) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "vertex ", v, " has a non-finite coordinate (", mesh.vertices[v].x, ", ",
-          mesh.vertices[v].y, ", ", mesh.vertices[v].z, ")"));
+      return absl::InvalidArgumentError(absl::StrCat("vertex ",
+                                                     v,
+                                                     " has a non-finite coordinate (",
+                                                     mesh.vertices[v].x,
+                                                     ", ",
+                                                     mesh.vertices[v].y,
+                                                     ", ",
+                                                     mesh.vertices[v].z,
+                                                     ")"));
     }
   }
   const std::size_t nv = mesh.vertices.size();
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     for (const uint32_t idx : mesh.triangles[t]) {
       if (idx >= nv) {
-        return absl::InvalidArgumentError(absl::StrCat("triangle ", t, " references vertex ", idx,
-                                                       " but the mesh has ", nv, " vertices"));
+        return absl::InvalidArgumentError(absl::StrCat(
+            "triangle ", t, " references vertex ", idx, " but the mesh has ", nv, " vertices"));
       }
     }
   }
@@ -99,11 +105,14 @@ absl::Status ValidateMesh(const TriangleMesh& mesh) {
   return absl::OkStatus();
 }
 
-void TransformMesh(const std::array<double, 9>& r, double scale, const Vec3d& translation,
+void TransformMesh(const std::array<double, 9>& r,
+                   double scale,
+                   const Vec3d& translation,
                    TriangleMesh* mesh) {
   for (Vec3f& p : mesh->vertices) {
     const Vec3d q(p);
-    const Vec3d rq(r[0] * q.x + r[1] * q.y + r[2] * q.z, r[3] * q.x + r[4] * q.y + r[5] * q.z,
+    const Vec3d rq(r[0] * q.x + r[1] * q.y + r[2] * q.z,
+                   r[3] * q.x + r[4] * q.y + r[5] * q.z,
                    r[6] * q.x + r[7] * q.y + r[8] * q.z);
     p = Vec3f(rq * scale + translation);
   }

@@ -34,9 +34,9 @@ struct TriangleMesh {
 // triangles touch when they share a vertex index; coincident but distinct
 // vertices do not connect, as in the file).
 struct MeshTopologyStats {
-  std::size_t components = 0;           // connected components of triangles
-  std::size_t boundary_edges = 0;       // edges used by exactly one triangle
-  std::size_t non_manifold_edges = 0;   // edges used by three or more triangles
+  std::size_t components = 0;          // connected components of triangles
+  std::size_t boundary_edges = 0;      // edges used by exactly one triangle
+  std::size_t non_manifold_edges = 0;  // edges used by three or more triangles
   std::size_t unreferenced_vertices = 0;
 };
 MeshTopologyStats ComputeTopologyStats(const TriangleMesh& mesh);
@@ -55,7 +55,9 @@ absl::Status ValidateMesh(const TriangleMesh& mesh);
 
 // Applies p -> scale * R p + t to every vertex (R row-major 3x3). Used by tests
 // and the synthetic benchmark to make rotated, scaled and moved copies.
-void TransformMesh(const std::array<double, 9>& rotation, double scale, const Vec3d& translation,
+void TransformMesh(const std::array<double, 9>& rotation,
+                   double scale,
+                   const Vec3d& translation,
                    TriangleMesh* mesh);
 
 }  // namespace meshseek

@@ -4,7 +4,6 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 #include <OpenMesh/Core/System/omstream.hh>
-
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -44,8 +43,8 @@ class SoupImporter : public OM::IO::BaseImporter {
     return OM::VertexHandle(static_cast<int>(positions.size()) - 1);
   }
   OM::VertexHandle add_vertex(const OM::Vec3d& p) override {
-    positions.emplace_back(static_cast<float>(p[0]), static_cast<float>(p[1]),
-                           static_cast<float>(p[2]));
+    positions.emplace_back(
+        static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]));
     return OM::VertexHandle(static_cast<int>(positions.size()) - 1);
   }
   OM::VertexHandle add_vertex() override { return add_vertex(OM::Vec3f(0, 0, 0)); }
@@ -70,10 +69,16 @@ class SoupImporter : public OM::IO::BaseImporter {
 
   // Connectivity-level and attribute calls: only the .om format uses the
   // former, and meshseek does not read attributes.
-  OM::HalfedgeHandle add_edge(OM::VertexHandle, OM::VertexHandle) override { return OM::HalfedgeHandle(); }
+  OM::HalfedgeHandle add_edge(OM::VertexHandle, OM::VertexHandle) override {
+    return OM::HalfedgeHandle();
+  }
   OM::FaceHandle add_face(OM::HalfedgeHandle) override { return OM::FaceHandle(); }
-  void add_face_texcoords(OM::FaceHandle, OM::VertexHandle, const std::vector<OM::Vec2f>&) override {}
-  void add_face_texcoords(OM::FaceHandle, OM::VertexHandle, const std::vector<OM::Vec3f>&) override {}
+  void add_face_texcoords(OM::FaceHandle,
+                          OM::VertexHandle,
+                          const std::vector<OM::Vec2f>&) override {}
+  void add_face_texcoords(OM::FaceHandle,
+                          OM::VertexHandle,
+                          const std::vector<OM::Vec3f>&) override {}
   void set_face_texindex(OM::FaceHandle, int) override {}
   void set_halfedge(OM::VertexHandle, OM::HalfedgeHandle) override {}
   void set_normal(OM::VertexHandle, const OM::Vec3f&) override {}
@@ -177,16 +182,20 @@ absl::StatusOr<MeshFormat> MeshFormatFromPath(absl::string_view path) {
   if (ext == "obj") return MeshFormat::kObj;
   if (ext == "ply") return MeshFormat::kPly;
   if (ext == "stl") return MeshFormat::kStl;
-  return absl::InvalidArgumentError(absl::StrCat(
-      path, ": unknown mesh format '", ext, "' (expected .off, .obj, .ply or .stl)"));
+  return absl::InvalidArgumentError(
+      absl::StrCat(path, ": unknown mesh format '", ext, "' (expected .off, .obj, .ply or .stl)"));
 }
 
 const char* MeshFormatName(MeshFormat format) {
   switch (format) {
-    case MeshFormat::kOff: return "OFF";
-    case MeshFormat::kObj: return "OBJ";
-    case MeshFormat::kPly: return "PLY";
-    case MeshFormat::kStl: return "STL";
+    case MeshFormat::kOff:
+      return "OFF";
+    case MeshFormat::kObj:
+      return "OBJ";
+    case MeshFormat::kPly:
+      return "PLY";
+    case MeshFormat::kStl:
+      return "STL";
   }
   return "?";
 }
@@ -194,15 +203,22 @@ const char* MeshFormatName(MeshFormat format) {
 std::string MeshReadReport::Summary() const {
   std::vector<std::string> parts;
   parts.push_back(absl::StrCat(file_vertices, " vertices, ", file_faces, " faces"));
-  parts.push_back(absl::StrCat(topology.components, " component",
-                               topology.components == 1 ? "" : "s"));
-  if (polygons_triangulated) parts.push_back(absl::StrCat(polygons_triangulated, " polygons triangulated"));
-  if (faces_repaired) parts.push_back(absl::StrCat(faces_repaired, " faces with repeated corners repaired"));
-  if (faces_dropped) parts.push_back(absl::StrCat(faces_dropped, " faces dropped (< 3 distinct corners)"));
-  if (zero_area_triangles) parts.push_back(absl::StrCat(zero_area_triangles, " zero-area triangles"));
-  if (topology.boundary_edges) parts.push_back(absl::StrCat(topology.boundary_edges, " boundary edges"));
-  if (topology.non_manifold_edges) parts.push_back(absl::StrCat(topology.non_manifold_edges, " non-manifold edges"));
-  if (topology.unreferenced_vertices) parts.push_back(absl::StrCat(topology.unreferenced_vertices, " unreferenced vertices"));
+  parts.push_back(
+      absl::StrCat(topology.components, " component", topology.components == 1 ? "" : "s"));
+  if (polygons_triangulated)
+    parts.push_back(absl::StrCat(polygons_triangulated, " polygons triangulated"));
+  if (faces_repaired)
+    parts.push_back(absl::StrCat(faces_repaired, " faces with repeated corners repaired"));
+  if (faces_dropped)
+    parts.push_back(absl::StrCat(faces_dropped, " faces dropped (< 3 distinct corners)"));
+  if (zero_area_triangles)
+    parts.push_back(absl::StrCat(zero_area_triangles, " zero-area triangles"));
+  if (topology.boundary_edges)
+    parts.push_back(absl::StrCat(topology.boundary_edges, " boundary edges"));
+  if (topology.non_manifold_edges)
+    parts.push_back(absl::StrCat(topology.non_manifold_edges, " non-manifold edges"));
+  if (topology.unreferenced_vertices)
+    parts.push_back(absl::StrCat(topology.unreferenced_vertices, " unreferenced vertices"));
   return absl::StrJoin(parts, ", ");
 }
 
@@ -246,9 +262,12 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, MeshReadReport* r
     ::omerr().disconnect(messages);
     if (!ok) {
       std::string detail(absl::StripAsciiWhitespace(messages.str()));
-      return absl::InvalidArgumentError(absl::StrCat(
-          path, ": OpenMesh could not parse the file as ", MeshFormatName(format),
-          detail.empty() ? "" : " (", detail, detail.empty() ? "" : ")"));
+      return absl::InvalidArgumentError(absl::StrCat(path,
+                                                     ": OpenMesh could not parse the file as ",
+                                                     MeshFormatName(format),
+                                                     detail.empty() ? "" : " (",
+                                                     detail,
+                                                     detail.empty() ? "" : ")"));
     }
   }
 
@@ -263,9 +282,8 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, MeshReadReport* r
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
     if (!IsFinite(mesh.vertices[v])) {
       const Vec3f& p = mesh.vertices[v];
-      return absl::InvalidArgumentError(absl::StrCat(path, ": vertex ", v,
-                                                     " has a non-finite coordinate (", p.x, ", ",
-                                                     p.y, ", ", p.z, ")"));
+      return absl::InvalidArgumentError(absl::StrCat(
+          path, ": vertex ", v, " has a non-finite coordinate (", p.x, ", ", p.y, ", ", p.z, ")"));
     }
   }
   const int64_t nv = static_cast<int64_t>(mesh.vertices.size());
@@ -277,8 +295,14 @@ absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, MeshReadReport* r
     for (std::size_t c = begin; c < end; ++c) {
       const int64_t idx = importer.corners[c];
       if (idx < 0 || idx >= nv) {
-        return absl::InvalidArgumentError(absl::StrCat(path, ": face ", f, " (0-based) references vertex ",
-                                                       idx, ", but the file has ", nv, " vertices"));
+        return absl::InvalidArgumentError(absl::StrCat(path,
+                                                       ": face ",
+                                                       f,
+                                                       " (0-based) references vertex ",
+                                                       idx,
+                                                       ", but the file has ",
+                                                       nv,
+                                                       " vertices"));
       }
       polygon.push_back(static_cast<uint32_t>(idx));
     }
@@ -328,7 +352,9 @@ void WriteOff(std::ostream& out, const TriangleMesh& mesh, bool binary) {
     PutLe<uint32_t>(out, static_cast<uint32_t>(mesh.triangles.size()));
     PutLe<uint32_t>(out, 0);
     for (const Vec3f& p : mesh.vertices) {
-      PutLe(out, p.x); PutLe(out, p.y); PutLe(out, p.z);
+      PutLe(out, p.x);
+      PutLe(out, p.y);
+      PutLe(out, p.z);
     }
     for (const Triangle& t : mesh.triangles) {
       PutLe<uint32_t>(out, 3);
@@ -338,7 +364,8 @@ void WriteOff(std::ostream& out, const TriangleMesh& mesh, bool binary) {
   }
   out << "OFF\n" << mesh.vertices.size() << ' ' << mesh.triangles.size() << " 0\n";
   for (const Vec3f& p : mesh.vertices) out << p.x << ' ' << p.y << ' ' << p.z << '\n';
-  for (const Triangle& t : mesh.triangles) out << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+  for (const Triangle& t : mesh.triangles)
+    out << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
 }
 
 void WriteObj(std::ostream& out, const TriangleMesh& mesh) {
@@ -358,7 +385,9 @@ void WritePly(std::ostream& out, const TriangleMesh& mesh, bool binary) {
       << "property list uchar int vertex_indices\nend_header\n";
   for (const Vec3f& p : mesh.vertices) {
     if (binary) {
-      PutLe(out, p.x); PutLe(out, p.y); PutLe(out, p.z);
+      PutLe(out, p.x);
+      PutLe(out, p.y);
+      PutLe(out, p.z);
     } else {
       out << p.x << ' ' << p.y << ' ' << p.z << '\n';
     }
@@ -381,10 +410,14 @@ void WriteStl(std::ostream& out, const TriangleMesh& mesh, bool binary) {
     PutLe<uint32_t>(out, static_cast<uint32_t>(mesh.triangles.size()));
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
       const Vec3f n(TriangleNormal(mesh, t));
-      PutLe(out, n.x); PutLe(out, n.y); PutLe(out, n.z);
+      PutLe(out, n.x);
+      PutLe(out, n.y);
+      PutLe(out, n.z);
       for (uint32_t v : mesh.triangles[t]) {
         const Vec3f& p = mesh.vertices[v];
-        PutLe(out, p.x); PutLe(out, p.y); PutLe(out, p.z);
+        PutLe(out, p.x);
+        PutLe(out, p.y);
+        PutLe(out, p.z);
       }
       PutLe<uint16_t>(out, 0);
     }
@@ -405,7 +438,8 @@ void WriteStl(std::ostream& out, const TriangleMesh& mesh, bool binary) {
 
 }  // namespace
 
-absl::Status WriteMesh(const std::string& path, const TriangleMesh& mesh,
+absl::Status WriteMesh(const std::string& path,
+                       const TriangleMesh& mesh,
                        const MeshWriteOptions& options) {
   MESHSEEK_ASSIGN_OR_RETURN(const MeshFormat format, MeshFormatFromPath(path));
   std::ofstream out(path, std::ios::binary);
@@ -415,10 +449,18 @@ absl::Status WriteMesh(const std::string& path, const TriangleMesh& mesh,
   }
   out.precision(9);  // float round-trip
   switch (format) {
-    case MeshFormat::kOff: WriteOff(out, mesh, options.binary); break;
-    case MeshFormat::kObj: WriteObj(out, mesh); break;
-    case MeshFormat::kPly: WritePly(out, mesh, options.binary); break;
-    case MeshFormat::kStl: WriteStl(out, mesh, options.binary); break;
+    case MeshFormat::kOff:
+      WriteOff(out, mesh, options.binary);
+      break;
+    case MeshFormat::kObj:
+      WriteObj(out, mesh);
+      break;
+    case MeshFormat::kPly:
+      WritePly(out, mesh, options.binary);
+      break;
+    case MeshFormat::kStl:
+      WriteStl(out, mesh, options.binary);
+      break;
   }
   out.flush();
   if (!out) return absl::DataLossError(absl::StrCat(path, ": write failed"));

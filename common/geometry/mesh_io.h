@@ -59,7 +59,8 @@ struct MeshWriteOptions {
 };
 
 // Writes `mesh` in the format given by the extension of `path`.
-absl::Status WriteMesh(const std::string& path, const TriangleMesh& mesh,
+absl::Status WriteMesh(const std::string& path,
+                       const TriangleMesh& mesh,
                        const MeshWriteOptions& options = {});
 
 }  // namespace meshseek

@@ -1,12 +1,12 @@
 #include "common/geometry/mesh_io.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "common/geometry/test_meshes.h"
 
@@ -29,7 +29,8 @@ TEST_P(RoundTripTest, EveryFormatReadsBackWhole) {
   const auto& [ext, binary] = GetParam();
   TriangleMesh mesh = testing_meshes::Icosphere(2, 1.5f);
   testing_meshes::Append(testing_meshes::Cube(0.5f), &mesh);  // a second component
-  const std::string path = TempPath("roundtrip_" + std::string(binary ? "bin" : "ascii") + "." + ext);
+  const std::string path =
+      TempPath("roundtrip_" + std::string(binary ? "bin" : "ascii") + "." + ext);
   ASSERT_TRUE(WriteMesh(path, mesh, {binary}).ok());
   MeshReadReport report;
   auto read = ReadMesh(path, &report);
@@ -47,10 +48,14 @@ TEST_P(RoundTripTest, EveryFormatReadsBackWhole) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Formats, RoundTripTest,
-                         ::testing::Values(std::make_tuple("off", false), std::make_tuple("off", true),
-                                           std::make_tuple("obj", false), std::make_tuple("ply", false),
-                                           std::make_tuple("ply", true), std::make_tuple("stl", false),
+INSTANTIATE_TEST_SUITE_P(Formats,
+                         RoundTripTest,
+                         ::testing::Values(std::make_tuple("off", false),
+                                           std::make_tuple("off", true),
+                                           std::make_tuple("obj", false),
+                                           std::make_tuple("ply", false),
+                                           std::make_tuple("ply", true),
+                                           std::make_tuple("stl", false),
                                            std::make_tuple("stl", true)));
 
 TEST(ReadMeshTest, PolygonSoupIsReadWhole) {
@@ -84,10 +89,10 @@ TEST(ReadMeshTest, KeepsNonManifoldFaces) {
 TEST(ReadMeshTest, TriangulatesPolygonsAndRepairsRepeatedCorners) {
   const std::string path = WriteText("polygons.off",
                                      "OFF\n6 4 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 1.5 0\n0 0 1\n"
-                                     "4 0 1 2 3\n"      // quad -> 2 triangles
-                                     "5 0 1 2 4 3\n"    // pentagon -> 3 triangles
-                                     "4 0 1 1 5\n"      // repeated corner -> 1 triangle
-                                     "3 0 0 1\n");      // < 3 distinct corners -> dropped
+                                     "4 0 1 2 3\n"    // quad -> 2 triangles
+                                     "5 0 1 2 4 3\n"  // pentagon -> 3 triangles
+                                     "4 0 1 1 5\n"    // repeated corner -> 1 triangle
+                                     "3 0 0 1\n");    // < 3 distinct corners -> dropped
   MeshReadReport report;
   auto read = ReadMesh(path, &report);
   ASSERT_TRUE(read.ok()) << read.status();
@@ -127,26 +132,32 @@ TEST(ReadMeshErrorTest, MissingFile) {
 }
 
 TEST(ReadMeshErrorTest, UnknownExtension) {
-  ExpectError(WriteText("model.xyz", "1 2 3\n"), absl::StatusCode::kInvalidArgument,
+  ExpectError(WriteText("model.xyz", "1 2 3\n"),
+              absl::StatusCode::kInvalidArgument,
               "unknown mesh format 'xyz'");
 }
 
 TEST(ReadMeshErrorTest, EmptyAndGarbageFiles) {
   ExpectError(WriteText("empty.off", ""), absl::StatusCode::kInvalidArgument, "empty");
-  ExpectError(WriteText("garbage.off", "this is not a mesh\n"), absl::StatusCode::kInvalidArgument,
+  ExpectError(WriteText("garbage.off", "this is not a mesh\n"),
+              absl::StatusCode::kInvalidArgument,
               "could not parse the file as OFF");
 }
 
 TEST(ReadMeshErrorTest, NonFiniteCoordinatesInAsciiNameTheLine) {
   ExpectError(WriteText("nan.off", "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"),
-              absl::StatusCode::kInvalidArgument, "line 4: non-finite coordinate 'nan'");
+              absl::StatusCode::kInvalidArgument,
+              "line 4: non-finite coordinate 'nan'");
   ExpectError(WriteText("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 -inf 0\nf 1 2 3\n"),
-              absl::StatusCode::kInvalidArgument, "line 3: non-finite coordinate '-inf'");
-  ExpectError(WriteText("huge.ply",
-                        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                        "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
-                        "end_header\n0 0 0\n1e999 0 0\n0 1 0\n3 0 1 2\n"),
-              absl::StatusCode::kInvalidArgument, "line 11: non-finite coordinate '1e999'");
+              absl::StatusCode::kInvalidArgument,
+              "line 3: non-finite coordinate '-inf'");
+  ExpectError(
+      WriteText("huge.ply",
+                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                "end_header\n0 0 0\n1e999 0 0\n0 1 0\n3 0 1 2\n"),
+      absl::StatusCode::kInvalidArgument,
+      "line 11: non-finite coordinate '1e999'");
 }
 
 TEST(ReadMeshErrorTest, NonFiniteCoordinatesInBinaryNameTheVertex) {
@@ -163,9 +174,11 @@ TEST(ReadMeshErrorTest, NonFiniteCoordinatesInBinaryNameTheVertex) {
 
 TEST(ReadMeshErrorTest, IndexOutOfRange) {
   ExpectError(WriteText("range.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 9\n"),
-              absl::StatusCode::kInvalidArgument, "face 1 (0-based) references vertex 9, but the file has 3 vertices");
+              absl::StatusCode::kInvalidArgument,
+              "face 1 (0-based) references vertex 9, but the file has 3 vertices");
   ExpectError(WriteText("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"),
-              absl::StatusCode::kInvalidArgument, "references vertex 3, but the file has 3 vertices");
+              absl::StatusCode::kInvalidArgument,
+              "references vertex 3, but the file has 3 vertices");
   TriangleMesh mesh = testing_meshes::Cube();
   mesh.triangles[3][1] = 1000;
   const std::string ply = TempPath("range_binary.ply");
@@ -175,14 +188,17 @@ TEST(ReadMeshErrorTest, IndexOutOfRange) {
 
 TEST(ReadMeshErrorTest, NoFaces) {
   ExpectError(WriteText("nofaces.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n"),
-              absl::StatusCode::kInvalidArgument, "mesh has no faces (3 vertices)");
-  ExpectError(WriteText("nofaces.obj", "v 0 0 0\nv 1 0 0\n"), absl::StatusCode::kInvalidArgument,
+              absl::StatusCode::kInvalidArgument,
+              "mesh has no faces (3 vertices)");
+  ExpectError(WriteText("nofaces.obj", "v 0 0 0\nv 1 0 0\n"),
+              absl::StatusCode::kInvalidArgument,
               "mesh has no faces");
 }
 
 TEST(ReadMeshErrorTest, ZeroTotalArea) {
   ExpectError(WriteText("flat.off", "OFF\n3 2 0\n0 0 0\n1 1 1\n2 2 2\n3 0 1 2\n3 2 1 0\n"),
-              absl::StatusCode::kInvalidArgument, "zero total surface area");
+              absl::StatusCode::kInvalidArgument,
+              "zero total surface area");
 }
 
 }  // namespace

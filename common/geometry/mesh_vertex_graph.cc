@@ -15,7 +15,8 @@ MeshVertexGraph BuildMeshVertexGraph(const TriangleMesh& mesh) {
   om.request_face_normals();
   std::vector<OmMesh::VertexHandle> handles;
   handles.reserve(mesh.vertices.size());
-  for (const Vec3f& p : mesh.vertices) handles.push_back(om.add_vertex(OmMesh::Point(p.x, p.y, p.z)));
+  for (const Vec3f& p : mesh.vertices)
+    handles.push_back(om.add_vertex(OmMesh::Point(p.x, p.y, p.z)));
   MeshVertexGraph result;
   result.duplicated_vertices = 0;
   std::vector<OmMesh::VertexHandle> face(3);

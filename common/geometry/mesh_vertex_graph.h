@@ -19,8 +19,8 @@
 namespace meshseek {
 
 struct MeshVertexGraph {
-  PointGraph graph;                 // vertices of the OpenMesh mesh (copies included)
-  std::vector<Vec3f> normals;       // unit vertex normals (OpenMesh: normalised sum of face normals)
+  PointGraph graph;            // vertices of the OpenMesh mesh (copies included)
+  std::vector<Vec3f> normals;  // unit vertex normals (OpenMesh: normalised sum of face normals)
   std::size_t duplicated_vertices;  // copies made for faces OpenMesh could not add
 };
 

@@ -1,7 +1,6 @@
 #include "common/geometry/point_graph.h"
 
 #include <algorithm>
-
 #include <flann/flann.hpp>
 
 #include "absl/strings/str_cat.h"
@@ -55,9 +54,8 @@ PointGraph MakePointGraph(std::vector<Vec3f> positions,
 absl::StatusOr<PointGraph> SymmetricKnnGraph(const std::vector<Vec3f>& points, int k) {
   if (k < 1) return absl::InvalidArgumentError(absl::StrCat("k must be >= 1, got ", k));
   if (points.size() <= static_cast<std::size_t>(k)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("a ", k, "-nearest-neighbour graph needs more than ", k, " points, got ",
-                     points.size()));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "a ", k, "-nearest-neighbour graph needs more than ", k, " points, got ", points.size()));
   }
   const std::size_t n = points.size();
   // FLANN wants a mutable row-major float matrix; Vec3f is three packed floats.

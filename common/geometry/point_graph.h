@@ -18,7 +18,7 @@ namespace meshseek {
 // repeats.
 struct PointGraph {
   std::vector<Vec3f> positions;
-  std::vector<uint32_t> offsets;    // size() + 1 entries
+  std::vector<uint32_t> offsets;  // size() + 1 entries
   std::vector<uint32_t> neighbors;
   // 1 for vertices on an open boundary of a mesh (an edge used by one face
   // only); scale-space detection skips them. All 0 for point-cloud graphs.
@@ -34,7 +34,8 @@ struct PointGraph {
 
 // Builds the adjacency from undirected edge lists (pairs may repeat and come
 // in either order; self-loops are dropped).
-PointGraph MakePointGraph(std::vector<Vec3f> positions, const std::vector<std::pair<uint32_t, uint32_t>>& edges);
+PointGraph MakePointGraph(std::vector<Vec3f> positions,
+                          const std::vector<std::pair<uint32_t, uint32_t>>& edges);
 
 // The symmetrised k-nearest-neighbour graph (Euclidean): i and j are joined
 // when either is among the other's k nearest (exact search, FLANN kd-tree;

@@ -23,8 +23,8 @@ PointGrid::PointGrid(const std::vector<Vec3f>& points, float cell_size)
   }
   sorted_.resize(points.size());
   std::iota(sorted_.begin(), sorted_.end(), 0u);
-  std::stable_sort(sorted_.begin(), sorted_.end(),
-                   [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
+  std::stable_sort(
+      sorted_.begin(), sorted_.end(), [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
   for (uint32_t i = 0; i < sorted_.size(); ++i) {
     const uint64_t key = keys[sorted_[i]];
     if (cell_keys_.empty() || cell_keys_.back() != key) {
@@ -41,8 +41,8 @@ int64_t PointGrid::CellCoord(float value, int axis) const {
 }
 
 uint64_t PointGrid::Key(int64_t ix, int64_t iy, int64_t iz) const {
-  return (static_cast<uint64_t>(ix) << (2 * kCoordBits)) | (static_cast<uint64_t>(iy) << kCoordBits) |
-         static_cast<uint64_t>(iz);
+  return (static_cast<uint64_t>(ix) << (2 * kCoordBits)) |
+         (static_cast<uint64_t>(iy) << kCoordBits) | static_cast<uint64_t>(iz);
 }
 
 void PointGrid::RadiusQuery(const Vec3f& center, float radius, std::vector<uint32_t>* out) const {

@@ -1,9 +1,9 @@
 #include "common/geometry/point_grid.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <random>
-
-#include <gtest/gtest.h>
 
 namespace meshseek {
 namespace {

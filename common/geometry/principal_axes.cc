@@ -6,7 +6,8 @@
 namespace meshseek {
 
 void SymmetricEigen3(const std::array<std::array<double, 3>, 3>& matrix,
-                     std::array<double, 3>* eigenvalues, std::array<Vec3d, 3>* eigenvectors) {
+                     std::array<double, 3>* eigenvalues,
+                     std::array<Vec3d, 3>* eigenvectors) {
   double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) a[i][j] = matrix[i][j];
@@ -20,7 +21,8 @@ void SymmetricEigen3(const std::array<std::array<double, 3>, 3>& matrix,
         if (a[p][q] == 0) continue;
         // Rotation that zeroes a[p][q] (Numerical Recipes' jacobi, stable form).
         const double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
-        const double t = (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1));
+        const double t =
+            (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1));
         const double c = 1 / std::sqrt(t * t + 1), s = t * c;
         for (int k = 0; k < 3; ++k) {  // A <- A J
           const double akp = a[k][p], akq = a[k][q];
@@ -69,7 +71,8 @@ PrincipalAxes AxesOf(const Vec3d& center, std::array<std::array<double, 3>, 3> c
 
 PrincipalAxes ComputeWeightedPrincipalAxes(const std::vector<Vec3f>& points,
                                            const std::vector<uint32_t>& subset,
-                                           const Vec3d& center, double radius) {
+                                           const Vec3d& center,
+                                           double radius) {
   std::array<std::array<double, 3>, 3> cov{};
   double total = 0;
   for (const uint32_t i : subset) {

@@ -34,13 +34,15 @@ PrincipalAxes ComputePrincipalAxes(const std::vector<Vec3f>& points,
 // under resampling and small deformations. `centroid` is set to `center`.
 PrincipalAxes ComputeWeightedPrincipalAxes(const std::vector<Vec3f>& points,
                                            const std::vector<uint32_t>& subset,
-                                           const Vec3d& center, double radius);
+                                           const Vec3d& center,
+                                           double radius);
 
 // Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations
 // (exact to round-off, robust for repeated eigenvalues). Eigenvalues in
 // decreasing order, eigenvectors as unit columns in the same order.
 void SymmetricEigen3(const std::array<std::array<double, 3>, 3>& matrix,
-                     std::array<double, 3>* eigenvalues, std::array<Vec3d, 3>* eigenvectors);
+                     std::array<double, 3>* eigenvalues,
+                     std::array<Vec3d, 3>* eigenvectors);
 
 }  // namespace meshseek
 

@@ -1,9 +1,9 @@
 #include "common/geometry/principal_axes.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <random>
-
-#include <gtest/gtest.h>
 
 namespace meshseek {
 namespace {

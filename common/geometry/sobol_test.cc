@@ -7,9 +7,15 @@ namespace {
 
 TEST(Sobol2DTest, MatchesNumericalRecipesTestVectors) {
   // DESIGN.md 2.1: the first ten points of NR's sobseq in two dimensions.
-  const double expected[10][2] = {{0.5, 0.5},       {0.25, 0.75},     {0.75, 0.25},
-                                  {0.375, 0.625},   {0.875, 0.125},   {0.125, 0.375},
-                                  {0.625, 0.875},   {0.3125, 0.3125}, {0.8125, 0.8125},
+  const double expected[10][2] = {{0.5, 0.5},
+                                  {0.25, 0.75},
+                                  {0.75, 0.25},
+                                  {0.375, 0.625},
+                                  {0.875, 0.125},
+                                  {0.125, 0.375},
+                                  {0.625, 0.875},
+                                  {0.3125, 0.3125},
+                                  {0.8125, 0.8125},
                                   {0.0625, 0.5625}};
   Sobol2D sobol;
   for (const auto& e : expected) {

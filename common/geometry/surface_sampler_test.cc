@@ -1,8 +1,8 @@
 #include "common/geometry/surface_sampler.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "common/geometry/test_meshes.h"
 

@@ -18,8 +18,18 @@ inline TriangleMesh Cube(float h = 1.0f) {
   for (int i = 0; i < 8; ++i) {
     m.vertices.emplace_back(i & 1 ? h : -h, i & 2 ? h : -h, i & 4 ? h : -h);
   }
-  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  m.triangles = {{0, 2, 1},
+                 {1, 2, 3},
+                 {4, 5, 6},
+                 {5, 7, 6},
+                 {0, 1, 4},
+                 {1, 5, 4},
+                 {2, 6, 3},
+                 {3, 6, 7},
+                 {0, 4, 2},
+                 {2, 4, 6},
+                 {1, 3, 5},
+                 {3, 7, 5}};
   return m;
 }
 
@@ -46,8 +56,18 @@ inline TriangleMesh Plane(int n, float h = 1.0f, float z0 = 0.0f) {
 // projected to the sphere. 20 * 4^levels triangles.
 inline TriangleMesh Icosphere(int levels, float r = 1.0f) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vec3d> v = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                          {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Vec3d> v = {{-1, t, 0},
+                          {1, t, 0},
+                          {-1, -t, 0},
+                          {1, -t, 0},
+                          {0, -1, t},
+                          {0, 1, t},
+                          {0, -1, -t},
+                          {0, 1, -t},
+                          {t, 0, -1},
+                          {t, 0, 1},
+                          {-t, 0, -1},
+                          {-t, 0, 1}};
   for (auto& p : v) p = Normalized(p);
   std::vector<Triangle> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                              {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
@@ -106,9 +126,15 @@ inline std::array<double, 9> AxisAngle(Vec3d axis, double angle) {
   axis = Normalized(axis);
   const double c = std::cos(angle), s = std::sin(angle), C = 1 - c;
   const double x = axis.x, y = axis.y, z = axis.z;
-  return {c + x * x * C,     x * y * C - z * s, x * z * C + y * s,
-          y * x * C + z * s, c + y * y * C,     y * z * C - x * s,
-          z * x * C - y * s, z * y * C + x * s, c + z * z * C};
+  return {c + x * x * C,
+          x * y * C - z * s,
+          x * z * C + y * s,
+          y * x * C + z * s,
+          c + y * y * C,
+          y * z * C - x * s,
+          z * x * C - y * s,
+          z * y * C + x * s,
+          c + z * z * C};
 }
 
 }  // namespace testing_meshes

@@ -36,7 +36,9 @@ TriangleBvh::TriangleBvh(const TriangleMesh& mesh) {
   if (n > 0) Build(0, static_cast<uint32_t>(n), boxes, centroids);
 }
 
-uint32_t TriangleBvh::Build(uint32_t begin, uint32_t end, const std::vector<Aabb>& boxes,
+uint32_t TriangleBvh::Build(uint32_t begin,
+                            uint32_t end,
+                            const std::vector<Aabb>& boxes,
                             const std::vector<Vec3f>& centroids) {
   const uint32_t index = static_cast<uint32_t>(nodes_.size());
   nodes_.push_back({});
@@ -52,9 +54,12 @@ uint32_t TriangleBvh::Build(uint32_t begin, uint32_t end, const std::vector<Aabb
     return index;
   }
   const Vec3f extent = centroid_box.max - centroid_box.min;
-  const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+  const int axis =
+      extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
   const uint32_t mid = begin + (end - begin) / 2;
-  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+  std::nth_element(order_.begin() + begin,
+                   order_.begin() + mid,
+                   order_.begin() + end,
                    [&](uint32_t a, uint32_t b) {
                      const float ca = centroids[a][axis], cb = centroids[b][axis];
                      return ca < cb || (ca == cb && a < b);
@@ -105,7 +110,8 @@ void TriangleBvh::Traverse(const Overlaps& overlaps, std::vector<uint32_t>* out)
     const Node& node = nodes_[index];
     if (!overlaps(node.box)) continue;
     if (node.count > 0) {
-      out->insert(out->end(), order_.begin() + node.first, order_.begin() + node.first + node.count);
+      out->insert(
+          out->end(), order_.begin() + node.first, order_.begin() + node.first + node.count);
     } else {
       stack[top++] = node.first;  // right child
       stack[top++] = index + 1;   // left child (depth-first layout)

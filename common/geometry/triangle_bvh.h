@@ -67,7 +67,9 @@ class TriangleBvh {
     uint32_t first;  // leaf: first index into order_; inner: index of the right child
     uint32_t count;  // leaf: number of triangles; inner: 0
   };
-  uint32_t Build(uint32_t begin, uint32_t end, const std::vector<Aabb>& boxes,
+  uint32_t Build(uint32_t begin,
+                 uint32_t end,
+                 const std::vector<Aabb>& boxes,
                  const std::vector<Vec3f>& centroids);
   template <typename Overlaps>
   void Traverse(const Overlaps& overlaps, std::vector<uint32_t>* out) const;

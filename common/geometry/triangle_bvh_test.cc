@@ -1,9 +1,9 @@
 #include "common/geometry/triangle_bvh.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "common/geometry/test_meshes.h"
 

@@ -27,9 +27,24 @@ struct Vec3T {
   constexpr Vec3T operator-() const { return {-x, -y, -z}; }
   constexpr Vec3T operator*(T s) const { return {x * s, y * s, z * s}; }
   constexpr Vec3T operator/(T s) const { return {x / s, y / s, z / s}; }
-  Vec3T& operator+=(const Vec3T& o) { x += o.x; y += o.y; z += o.z; return *this; }
-  Vec3T& operator-=(const Vec3T& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
-  Vec3T& operator*=(T s) { x *= s; y *= s; z *= s; return *this; }
+  Vec3T& operator+=(const Vec3T& o) {
+    x += o.x;
+    y += o.y;
+    z += o.z;
+    return *this;
+  }
+  Vec3T& operator-=(const Vec3T& o) {
+    x -= o.x;
+    y -= o.y;
+    z -= o.z;
+    return *this;
+  }
+  Vec3T& operator*=(T s) {
+    x *= s;
+    y *= s;
+    z *= s;
+    return *this;
+  }
   constexpr bool operator==(const Vec3T& o) const { return x == o.x && y == o.y && z == o.z; }
   constexpr bool operator!=(const Vec3T& o) const { return !(*this == o); }
 };
@@ -38,21 +53,33 @@ using Vec3f = Vec3T<float>;
 using Vec3d = Vec3T<double>;
 
 template <typename T>
-constexpr Vec3T<T> operator*(T s, const Vec3T<T>& v) { return v * s; }
+constexpr Vec3T<T> operator*(T s, const Vec3T<T>& v) {
+  return v * s;
+}
 template <typename T>
-constexpr T Dot(const Vec3T<T>& a, const Vec3T<T>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+constexpr T Dot(const Vec3T<T>& a, const Vec3T<T>& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 template <typename T>
 constexpr Vec3T<T> Cross(const Vec3T<T>& a, const Vec3T<T>& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 template <typename T>
-constexpr T SquaredNorm(const Vec3T<T>& v) { return Dot(v, v); }
+constexpr T SquaredNorm(const Vec3T<T>& v) {
+  return Dot(v, v);
+}
 template <typename T>
-T Norm(const Vec3T<T>& v) { return std::sqrt(Dot(v, v)); }
+T Norm(const Vec3T<T>& v) {
+  return std::sqrt(Dot(v, v));
+}
 template <typename T>
-T SquaredDistance(const Vec3T<T>& a, const Vec3T<T>& b) { return SquaredNorm(a - b); }
+T SquaredDistance(const Vec3T<T>& a, const Vec3T<T>& b) {
+  return SquaredNorm(a - b);
+}
 template <typename T>
-T Distance(const Vec3T<T>& a, const Vec3T<T>& b) { return Norm(a - b); }
+T Distance(const Vec3T<T>& a, const Vec3T<T>& b) {
+  return Norm(a - b);
+}
 // Unit vector along v, or the zero vector if v has (near) zero length.
 template <typename T>
 Vec3T<T> Normalized(const Vec3T<T>& v) {

@@ -72,11 +72,15 @@ absl::StatusOr<std::vector<LocalFeatures>> ExtractCollection(
     if (errors[i].ok()) continue;
     const std::size_t failed =
         std::count_if(errors.begin(), errors.end(), [](const absl::Status& s) { return !s.ok(); });
-    return absl::Status(errors[i].code(),
-                        absl::StrCat("model '", models[i].id, "' (manifest line ", models[i].line,
-                                     "): ", errors[i].message(),
-                                     failed > 1 ? absl::StrCat(" [and ", failed - 1, " more failed models]")
-                                                : ""));
+    return absl::Status(
+        errors[i].code(),
+        absl::StrCat("model '",
+                     models[i].id,
+                     "' (manifest line ",
+                     models[i].line,
+                     "): ",
+                     errors[i].message(),
+                     failed > 1 ? absl::StrCat(" [and ", failed - 1, " more failed models]") : ""));
   }
   return features;
 }
@@ -96,7 +100,8 @@ absl::StatusOr<Codebook> TrainCollectionCodebook(const std::vector<LocalFeatures
 }
 
 absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
-    const Codebook& codebook, const std::vector<LocalFeatures>& features,
+    const Codebook& codebook,
+    const std::vector<LocalFeatures>& features,
     const RetrievalPipelineOptions& options) {
   std::vector<std::vector<float>> histograms(features.size());
   std::vector<absl::Status> errors(features.size());
@@ -183,15 +188,16 @@ absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<Manife
 }
 
 absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
-                             const RetrievalPipelineOptions& options, const std::string& out_dir) {
+                             const RetrievalPipelineOptions& options,
+                             const std::string& out_dir) {
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec) {
     return absl::PermissionDeniedError(
         absl::StrCat(out_dir, ": cannot create folder (", ec.message(), ")"));
   }
-  MESHSEEK_RETURN_IF_ERROR(WriteDistanceMatrix(out_dir + "/distances.bin", evaluation.distances,
-                                               evaluation.models.size()));
+  MESHSEEK_RETURN_IF_ERROR(WriteDistanceMatrix(
+      out_dir + "/distances.bin", evaluation.distances, evaluation.models.size()));
   Json report = MetricsToJson(evaluation.metrics);
   report.Set("models", static_cast<int64_t>(evaluation.models.size()));
   report.Set("parameters", options.ToJson());
@@ -200,7 +206,8 @@ absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
   if (!per_model.empty()) {
     std::vector<std::size_t> sorted = per_model;
     std::sort(sorted.begin(), sorted.end());
-    counts.Set("total", static_cast<int64_t>(std::accumulate(sorted.begin(), sorted.end(), std::size_t{0})));
+    counts.Set("total",
+               static_cast<int64_t>(std::accumulate(sorted.begin(), sorted.end(), std::size_t{0})));
     counts.Set("min_per_model", static_cast<int64_t>(sorted.front()));
     counts.Set("median_per_model", static_cast<int64_t>(sorted[sorted.size() / 2]));
     counts.Set("max_per_model", static_cast<int64_t>(sorted.back()));

@@ -61,7 +61,8 @@ absl::StatusOr<Codebook> TrainCollectionCodebook(const std::vector<LocalFeatures
 // One normalised histogram per model; an empty one for a model without local
 // features (LD-SIFT and RLD-SIFT may detect nothing on a model).
 absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
-    const Codebook& codebook, const std::vector<LocalFeatures>& features,
+    const Codebook& codebook,
+    const std::vector<LocalFeatures>& features,
     const RetrievalPipelineOptions& options);
 
 // All-pairs symmetric KL distances, N x N row-major. A model without features
@@ -81,7 +82,7 @@ struct StageTimings {
 };
 
 struct CollectionEvaluation {
-  std::vector<ManifestEntry> models;           // input order = matrix order
+  std::vector<ManifestEntry> models;  // input order = matrix order
   std::vector<std::size_t> features_per_model;
   std::size_t models_without_features = 0;
   std::size_t codebook_size = 0;
@@ -98,7 +99,8 @@ absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<Manife
 // DIR/metrics.json (every metric, micro and macro, per class, the parameters,
 // feature counts and stage timings). Creates DIR if needed.
 absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
-                             const RetrievalPipelineOptions& options, const std::string& out_dir);
+                             const RetrievalPipelineOptions& options,
+                             const std::string& out_dir);
 
 }  // namespace meshseek
 

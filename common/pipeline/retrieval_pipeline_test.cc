@@ -1,8 +1,8 @@
 #include "common/pipeline/retrieval_pipeline.h"
 
-#include <algorithm>
-
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 #include "common/geometry/test_meshes.h"
 #include "common/synth/synthetic_benchmark.h"
