@@ -44,7 +44,7 @@ double Divergence(const std::vector<float>& x,
 TEST(KlDivergenceOptionsTest, DefaultsAreValidAndPinned) {
   const KlDivergenceOptions options;
   EXPECT_TRUE(options.Validate().ok());
-  EXPECT_EQ(options.epsilon, 1e-6);
+  EXPECT_EQ(options.epsilon, 1e-10);
   EXPECT_EQ(options.sum_tolerance, 1e-3);
 }
 

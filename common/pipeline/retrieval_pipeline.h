@@ -31,7 +31,8 @@ struct RetrievalPipelineOptions {
   /// Local features: the method and its parameters.
   ExtractorOptions extractor;
   /// Codebook learning; kmeans.num_centroids is the vocabulary size V. The
-  /// default V was chosen on the development sets (README, bench/).
+  /// defaults (V = 2,000, k-means on 100 sampled features per word) were
+  /// chosen on the development sets (README, bench/results).
   KMeansOptions kmeans;
   /// Ranking: symmetric KL divergence and its zero-bin rule.
   KlDivergenceOptions kl;

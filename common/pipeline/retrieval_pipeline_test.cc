@@ -14,10 +14,15 @@ TEST(RetrievalPipelineOptionsTest, DefaultsArePinnedAndValid) {
   const RetrievalPipelineOptions options;
   EXPECT_TRUE(options.Validate().ok());
   EXPECT_EQ(options.extractor.method, FeatureMethod::kDldSift);
-  EXPECT_EQ(options.kmeans.num_centroids, 1000);
-  EXPECT_EQ(options.kl.epsilon, 1e-6);
+  EXPECT_EQ(options.kmeans.num_centroids, 2000);
+  EXPECT_EQ(options.kmeans.max_points_per_centroid, 100);
+  EXPECT_EQ(options.kl.epsilon, 1e-10);
+  EXPECT_EQ(options.extractor.dld.scale, 0.2);
+  EXPECT_TRUE(options.extractor.dld.weighted_frame);
+  EXPECT_EQ(options.extractor.dld.frame_samples_per_support, 512);
+  EXPECT_EQ(options.extractor.dld.descriptor.orientation, ImageOrientation::kDominant);
   const std::string json = options.ToJson().Dump();
-  EXPECT_NE(json.find("\"vocabulary_size_V\": 1000"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"vocabulary_size_V\": 2000"), std::string::npos) << json;
 }
 
 // A model and a rotated, scaled and moved copy of it get nearly the same
