@@ -6,7 +6,8 @@
 #
 #   bench/e_sweep.sh [DATA_DIR]    (default: ~/.cache/meshseek-data, from ../shared/data/unpack.sh)
 #
-# About 40 minutes on 2 cores. Needs python3-matplotlib for the plot.
+# About 40 minutes on 2 cores. The plot needs python3-matplotlib (Debian), run by
+# /usr/bin/python3 unless PYTHON says otherwise.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA=${1:-$HOME/.cache/meshseek-data}
@@ -20,7 +21,7 @@ for set in msb_articulated psb_train; do
   build/bench/sweep --manifest "$DATA/$set/manifest.csv" --scales "$SCALES" --progress=false \
     --tag "$set" --csv "$CSV"
 done
-python3 bench/plot_e_sweep.py "$OUT/e_sweep.png" "$CSV" \
+"${PYTHON:-/usr/bin/python3}" bench/plot_e_sweep.py "$OUT/e_sweep.png" "$CSV" \
   --series "msb_articulated=McGill articulated (255)" --series "psb_train=PSB train (904)" \
   --reference "paper DLD-SIFT, MSB: 74.5=74.5"
 echo "wrote $CSV and $OUT/e_sweep.png"

@@ -28,7 +28,7 @@ ABSL_FLAG(std::string,
           scales,
           "0.2",
           "comma-separated scales: E for --method dld, C (scale factor) for ld and rld");
-ABSL_FLAG(std::string, vocabularies, "1000", "comma-separated codebook sizes V");
+ABSL_FLAG(std::string, vocabularies, "", "comma-separated codebook sizes V (default: the shipped one)");
 ABSL_FLAG(std::string, epsilons, "", "comma-separated KL epsilons (default: the shipped one)");
 ABSL_FLAG(std::string, csv, "", "append result rows to this CSV file");
 ABSL_FLAG(std::string, tag, "", "free text copied into the CSV rows");
@@ -74,7 +74,13 @@ int main(int argc, char** argv) {
   std::printf(
       "tag,scale,V,epsilon,RP_excl_micro,RP_excl_macro,RP_incl_micro,NN_micro,ST_micro,DCG_micro,"
       "extract_s\n");
-  for (double scale : ParseList<double>(absl::GetFlag(FLAGS_scales))) {
+  std::vector<double> scales = ParseList<double>(absl::GetFlag(FLAGS_scales));
+  if (scales.empty()) {
+    scales.push_back(options.extractor.method == FeatureMethod::kDldSift
+                         ? options.extractor.dld.scale
+                         : options.extractor.rld.scale_space.scale_factor);
+  }
+  for (double scale : scales) {
     // The method's scale knob: E for DLD-SIFT, C for the scale-space methods.
     options.extractor.dld.scale = scale;
     options.extractor.ld.scale_space.scale_factor = scale;
@@ -87,7 +93,9 @@ int main(int argc, char** argv) {
     }
     const double extract_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    for (int v : ParseList<int>(absl::GetFlag(FLAGS_vocabularies))) {
+    std::vector<int> vocabularies = ParseList<int>(absl::GetFlag(FLAGS_vocabularies));
+    if (vocabularies.empty()) vocabularies.push_back(options.kmeans.num_centroids);
+    for (int v : vocabularies) {
       options.kmeans.num_centroids = v;
       auto codebook = TrainCollectionCodebook(*features, options);
       if (!codebook.ok()) {

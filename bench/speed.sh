@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Speed and memory of the shipped defaults on this machine:
+#   1. per-model extraction time of every method on one core (median and p90
+#      over the first 50 McGill articulated models, ~13k vertices each), and
+#      RLD-SIFT's time against N_RLD;
+#   2. the whole `meshseek eval` of McGill articulated on all cores: wall time
+#      and peak memory.
+# Results go to bench/results/speed_*.{json,txt}.
+#
+#   bench/speed.sh [DATA_DIR]    (default: ~/.cache/meshseek-data)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+DATA=${1:-$HOME/.cache/meshseek-data}
+OUT=bench/results
+mkdir -p "$OUT"
+./scripts/build.sh >/dev/null
+{
+  echo "machine: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores, $(free -g | awk '/Mem:/{print $2}') GiB"
+  echo "date: $(date -u +%Y-%m-%d)"
+  echo "command: build/bench/extract_benchmark --models_dir=$DATA/msb_articulated/models --max_models=50"
+} > "$OUT/speed_extract.txt"
+build/bench/extract_benchmark --models_dir="$DATA/msb_articulated/models" --max_models=50 \
+  --benchmark_format=json --benchmark_out="$OUT/speed_extract.json" --benchmark_out_format=json \
+  | tee -a "$OUT/speed_extract.txt"
+{
+  echo "machine: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores"
+  echo "command: build/cli/meshseek eval --manifest $DATA/msb_articulated/manifest.csv --method dld --out out/msb"
+  /usr/bin/time -f "wall %e s, user %U s, peak RSS %M KiB" \
+    build/cli/meshseek eval --manifest "$DATA/msb_articulated/manifest.csv" --method dld --out out/msb \
+    --progress=false 2>&1
+} | tee "$OUT/speed_eval_msb.txt"
