@@ -25,6 +25,8 @@ ABSL_FLAG(int,
           frame_samples,
           kDld.frame_samples_per_support,
           "dld: dense surface samples per support disc for the local PCA frame");
+ABSL_FLAG(double, frame_radius, kDld.frame_radius_factor,
+          "dld: the local frame uses the samples within this many times the support radius");
 ABSL_FLAG(int, rld_samples, kRld.num_samples, "rld: resample points (N_RLD)");
 ABSL_FLAG(int, rld_neighbors, kRld.neighbors, "rld: k of the k-nearest-neighbour graph");
 ABSL_FLAG(int, levels, kRld.scale_space.levels, "ld, rld: scale-space levels L");
@@ -112,6 +114,7 @@ absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags() {
   extractor.dld.num_points = absl::GetFlag(FLAGS_points);
   extractor.dld.frame_samples_per_support = absl::GetFlag(FLAGS_frame_samples);
   extractor.dld.weighted_frame = absl::GetFlag(FLAGS_weighted_frame);
+  extractor.dld.frame_radius_factor = absl::GetFlag(FLAGS_frame_radius);
   extractor.rld.num_samples = absl::GetFlag(FLAGS_rld_samples);
   extractor.rld.neighbors = absl::GetFlag(FLAGS_rld_neighbors);
   extractor.rld.weighted_frame = absl::GetFlag(FLAGS_weighted_frame);

@@ -21,6 +21,10 @@ absl::Status DldSiftOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("DLD-SIFT scale E must be in (0, 2], got ", scale));
   }
+  if (!(frame_radius_factor >= 0.25 && frame_radius_factor <= 4)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "DLD-SIFT frame_radius_factor must be in [0.25, 4], got ", frame_radius_factor));
+  }
   if (frame_samples_per_support < 8) {
     return absl::InvalidArgumentError(absl::StrCat(
         "DLD-SIFT frame_samples_per_support must be >= 8, got ", frame_samples_per_support));
@@ -52,7 +56,8 @@ absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh,
   const int64_t frame_count = static_cast<int64_t>(
       std::clamp<double>(std::ceil(wanted), options.min_frame_samples, options.max_frame_samples));
   MESHSEEK_ASSIGN_OR_RETURN(const SurfacePoints dense, SampleSurface(mesh, frame_count));
-  const PointGrid grid(dense.positions, static_cast<float>(s));
+  const double frame_radius = options.frame_radius_factor * s;
+  const PointGrid grid(dense.positions, static_cast<float>(frame_radius));
   LocalDepthSift describer(mesh, options.depth_image, options.descriptor);
 
   LocalFeatures features;
@@ -60,7 +65,8 @@ absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh,
   features.descriptors.reserve(2 * centres.size() * kSiftDimension);
   std::vector<uint32_t> support;
   for (const Vec3f& p : centres.positions) {
-    const auto axes = SupportAxes(dense.positions, grid, p, s, options.weighted_frame, &support);
+    const auto axes =
+        SupportAxes(dense.positions, grid, p, frame_radius, options.weighted_frame, &support);
     if (!axes) continue;
     describer.Describe(
         {Vec3d(p), axes->axes[0], axes->axes[2], s}, options.two_views, 0, &features);

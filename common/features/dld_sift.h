@@ -45,6 +45,9 @@ struct DldSiftOptions {
   /// repeatable local reference frame) instead of plain PCA about the
   /// centroid of the support.
   bool weighted_frame = true;
+  /// The local frame's PCA uses the samples within this many times s (the
+  /// depth images always cover s).
+  double frame_radius_factor = 1.0;
   /// Target number of dense samples in a flat disc of radius s for the local
   /// PCA frame; the dense sample count is this times area / (pi s^2).
   int frame_samples_per_support = 512;

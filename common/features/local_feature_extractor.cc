@@ -65,6 +65,7 @@ Json ExtractorOptions::ToJson() const {
       json.Set("two_views", dld.two_views);
       json.Set("frame_samples_per_support", dld.frame_samples_per_support);
       json.Set("weighted_frame", dld.weighted_frame);
+      json.Set("frame_radius_factor", dld.frame_radius_factor);
       json.Set("image_size", dld.depth_image.image_size);
       DescriptorToJson(dld.descriptor, &json);
       break;
