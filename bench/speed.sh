@@ -20,8 +20,15 @@ mkdir -p "$OUT"
   echo "command: build/bench/extract_benchmark --models_dir=$DATA/msb_articulated/models --max_models=50"
 } > "$OUT/speed_extract.txt"
 build/bench/extract_benchmark --models_dir="$DATA/msb_articulated/models" --max_models=50 \
-  --benchmark_format=json --benchmark_out="$OUT/speed_extract.json" --benchmark_out_format=json \
-  | tee -a "$OUT/speed_extract.txt"
+  --benchmark_out="$OUT/speed_extract.json" --benchmark_out_format=json >/dev/null
+"${PYTHON:-/usr/bin/python3}" - "$OUT/speed_extract.json" >> "$OUT/speed_extract.txt" <<'PY'
+import json, sys
+for b in json.load(open(sys.argv[1]))['benchmarks']:
+    print('%-28s median %6.1f ms/model  p90 %6.1f ms  %5.0f features/model  (%d models, %.0f vertices on average)'
+          % (b['name'].split('/iterations')[0], b['median_ms_per_model'], b['p90_ms_per_model'],
+             b['features_per_model'], b['models'], b['mean_vertices']))
+PY
+cat "$OUT/speed_extract.txt"
 {
   echo "machine: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores"
   echo "command: build/cli/meshseek eval --manifest $DATA/msb_articulated/manifest.csv --method dld --out out/msb"
