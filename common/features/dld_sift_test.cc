@@ -20,12 +20,6 @@ TriangleMesh LumpyBlob(int levels = 3) {
   return mesh;
 }
 
-double L2(const uint8_t* a, const uint8_t* b) {
-  double s = 0;
-  for (int k = 0; k < kSiftDimension; ++k) s += (a[k] - b[k]) * double(a[k] - b[k]);
-  return std::sqrt(s);
-}
-
 TEST(DldSiftOptionsTest, DefaultsArePinnedAndValid) {
   const DldSiftOptions options;
   EXPECT_EQ(options.num_points, 1024);  // the paper's N_DLD
@@ -120,9 +114,9 @@ void ExpectSimilarityInvariance(ImageOrientation orientation) {
   for (std::size_t p = 0; p < ga.size(); ++p) {
     for (const uint8_t* d : ga[p]) {
       double best = 1e30;
-      for (const uint8_t* e : gb[p]) best = std::min(best, L2(d, e));
+      for (const uint8_t* e : gb[p]) best = std::min(best, DescriptorDistance(d, e));
       matched += best;
-      unrelated += L2(d, gb[(p + 50) % gb.size()][0]);
+      unrelated += DescriptorDistance(d, gb[(p + 50) % gb.size()][0]);
       ++count;
     }
   }

@@ -25,10 +25,7 @@ absl::StatusOr<LocalFeatures> ExtractLdSift(const TriangleMesh& mesh,
   std::vector<InterestPoint> points = DetectInterestPoints(graph, options.scale_space);
   LocalFeatures features;
   if (!points.empty()) {
-    std::vector<float> scales;
-    for (const InterestPoint& ip : points) scales.push_back(ip.scale);
-    std::nth_element(scales.begin(), scales.begin() + scales.size() / 2, scales.end());
-    const PointGrid grid(graph.positions, std::max(scales[scales.size() / 2], 1e-12f));
+    const PointGrid grid(graph.positions, std::max(MedianScale(points), 1e-12f));
     LocalDepthSift describer(mesh, options.depth_image, options.descriptor);
     std::vector<uint32_t> support;
     for (const InterestPoint& ip : points) {

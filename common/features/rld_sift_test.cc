@@ -31,12 +31,6 @@ TriangleMesh BumpyShape(int levels) {
   return mesh;
 }
 
-double L2(const uint8_t* a, const uint8_t* b) {
-  double s = 0;
-  for (int k = 0; k < kSiftDimension; ++k) s += (a[k] - b[k]) * double(a[k] - b[k]);
-  return std::sqrt(s);
-}
-
 TEST(RldSiftOptionsTest, DefaultsArePinnedAndValid) {
   const RldSiftOptions rld;
   EXPECT_EQ(rld.num_samples, 15000);  // the paper's N_RLD
@@ -123,7 +117,7 @@ void ExpectInvariance(const Extract& extract) {
     double best = 1e30;
     for (std::size_t j = 0; j < b.size(); ++j) {
       if (Distance(Vec3d(b.keypoints[j].position), q) < 1e-3 * scale) {
-        best = std::min(best, L2(a.descriptor(i), b.descriptor(j)));
+        best = std::min(best, DescriptorDistance(a.descriptor(i), b.descriptor(j)));
       }
     }
     if (best > 1e29) {
@@ -131,7 +125,7 @@ void ExpectInvariance(const Extract& extract) {
       continue;
     }
     matched += best;
-    unrelated += L2(a.descriptor(i), b.descriptor((i + b.size() / 2) % b.size()));
+    unrelated += DescriptorDistance(a.descriptor(i), b.descriptor((i + b.size() / 2) % b.size()));
     ++count;
   }
   EXPECT_LT(unmatched, a.size() / 50) << "points without a counterpart";

@@ -1,5 +1,6 @@
 #include "common/features/scale_space.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
@@ -16,6 +17,15 @@ absl::Status ScaleSpaceOptions::Validate() const {
         absl::StrCat("scale factor C must be positive, got ", scale_factor));
   }
   return absl::OkStatus();
+}
+
+float MedianScale(const std::vector<InterestPoint>& points) {
+  if (points.empty()) return 0;
+  std::vector<float> scales;
+  scales.reserve(points.size());
+  for (const InterestPoint& p : points) scales.push_back(p.scale);
+  std::nth_element(scales.begin(), scales.begin() + scales.size() / 2, scales.end());
+  return scales[scales.size() / 2];
 }
 
 std::vector<InterestPoint> DetectInterestPoints(const PointGraph& graph,

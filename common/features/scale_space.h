@@ -47,6 +47,10 @@ struct InterestPoint {
 std::vector<InterestPoint> DetectInterestPoints(const PointGraph& graph,
                                                 const ScaleSpaceOptions& options);
 
+// The median feature scale of `points` (a good cell size for a grid of
+// support points); 0 if there are none.
+float MedianScale(const std::vector<InterestPoint>& points);
+
 }  // namespace meshseek
 
 #endif  // MESHSEEK_COMMON_FEATURES_SCALE_SPACE_H_

@@ -28,6 +28,15 @@ int Rotate180Index(int bin) {
   return ((3 - row) * 4 + (3 - col)) * 8 + (orientation + 4) % 8;
 }
 
+double DescriptorDistance(const uint8_t* a, const uint8_t* b) {
+  double sum = 0;
+  for (int k = 0; k < kSiftDimension; ++k) {
+    const double d = static_cast<double>(a[k]) - b[k];
+    sum += d * d;
+  }
+  return std::sqrt(sum);
+}
+
 void NormalizeSiftDescriptor(float* bins, uint8_t* out) {
   auto normalize = [bins] {
     double sq = 0;

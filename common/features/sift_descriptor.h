@@ -75,6 +75,9 @@ struct SiftDescriptorOptions {
 // parabola; strongest first. Empty for an image without gradient.
 std::vector<float> DominantOrientations(const DepthImage& image, float peak_ratio = 0.8f);
 
+// Euclidean distance between two byte descriptors.
+double DescriptorDistance(const uint8_t* a, const uint8_t* b);
+
 // Turns float SIFT bins into SIFT's normalised byte form (in place on `bins`,
 // result in `out`).
 void NormalizeSiftDescriptor(float* bins, uint8_t* out);

@@ -55,12 +55,6 @@ SiftDescriptorOptions UpAxisOptions() {
   return options;
 }
 
-double L2(const uint8_t* a, const uint8_t* b) {
-  double s = 0;
-  for (int k = 0; k < kSiftDimension; ++k) s += (a[k] - b[k]) * double(a[k] - b[k]);
-  return std::sqrt(s);
-}
-
 TEST(SiftDescriptorTest, Rotate180IsAnInvolutivePermutation) {
   std::set<int> seen;
   for (int k = 0; k < kSiftDimension; ++k) {
@@ -77,7 +71,7 @@ TEST(SiftDescriptorTest, SymmetrisedDescriptorIgnoresTheUpAxisSign) {
     const auto a = DescribeOne(&describer, image);
     const auto b = DescribeOne(&describer, Turn180(image));
     // Byte rounding and OpenCV's border handling allow a few units per bin.
-    EXPECT_LT(L2(a.data(), b.data()), 12.0) << "seed " << seed;
+    EXPECT_LT(DescriptorDistance(a.data(), b.data()), 12.0) << "seed " << seed;
   }
 }
 
@@ -92,8 +86,9 @@ TEST(SiftDescriptorTest, PermutationMatchesOpenCvOnTurnedImage) {
   const auto b = DescribeOne(&describer, Turn180(image));
   uint8_t permuted[kSiftDimension];
   for (int k = 0; k < kSiftDimension; ++k) permuted[k] = a[Rotate180Index(k)];
-  EXPECT_LT(L2(permuted, b.data()), 12.0);
-  EXPECT_GT(L2(a.data(), b.data()), 40.0);  // and the turn does change the raw descriptor
+  EXPECT_LT(DescriptorDistance(permuted, b.data()), 12.0);
+  EXPECT_GT(DescriptorDistance(a.data(), b.data()),
+            40.0);  // and the turn does change the raw descriptor
 }
 
 TEST(SiftDescriptorTest, DescriptorIsNormalisedAndDistinguishesImages) {
@@ -103,7 +98,7 @@ TEST(SiftDescriptorTest, DescriptorIsNormalisedAndDistinguishesImages) {
   double sq = 0;
   for (int k = 0; k < kSiftDimension; ++k) sq += a[k] * double(a[k]);
   EXPECT_NEAR(std::sqrt(sq), 512.0, 10.0);
-  EXPECT_GT(L2(a.data(), b.data()), 50.0);
+  EXPECT_GT(DescriptorDistance(a.data(), b.data()), 50.0);
 }
 
 TEST(SiftDescriptorTest, ContrastScaleDoesNotMatterWithStretch) {
@@ -115,7 +110,7 @@ TEST(SiftDescriptorTest, ContrastScaleDoesNotMatterWithStretch) {
   for (float& d : scaled.depth) d = 0.1f + 0.5f * d;
   const auto a = DescribeOne(&describer, image);
   const auto b = DescribeOne(&describer, scaled);
-  EXPECT_LT(L2(a.data(), b.data()), 12.0);
+  EXPECT_LT(DescriptorDistance(a.data(), b.data()), 12.0);
 }
 
 TEST(SiftDescriptorTest, DominantOrientationFollowsTheImageRotation) {
@@ -145,7 +140,8 @@ TEST(SiftDescriptorTest, DominantOrientationFollowsTheImageRotation) {
     ASSERT_GE(nb, 1);
     double best = 1e9;
     for (int i = 0; i < na; ++i) {
-      for (int j = 0; j < nb; ++j) best = std::min(best, L2(&a[i * 128], &b[j * 128]));
+      for (int j = 0; j < nb; ++j)
+        best = std::min(best, DescriptorDistance(&a[i * 128], &b[j * 128]));
     }
     EXPECT_LT(best, 60.0) << "seed " << seed;  // unrelated descriptors are ~500 apart
   }
