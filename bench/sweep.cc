@@ -28,7 +28,10 @@ ABSL_FLAG(std::string,
           scales,
           "0.2",
           "comma-separated scales: E for --method dld, C (scale factor) for ld and rld");
-ABSL_FLAG(std::string, vocabularies, "", "comma-separated codebook sizes V (default: the shipped one)");
+ABSL_FLAG(std::string,
+          vocabularies,
+          "",
+          "comma-separated codebook sizes V (default: the shipped one)");
 ABSL_FLAG(std::string, epsilons, "", "comma-separated KL epsilons (default: the shipped one)");
 ABSL_FLAG(std::string, csv, "", "append result rows to this CSV file");
 ABSL_FLAG(std::string, tag, "", "free text copied into the CSV rows");
@@ -76,9 +79,17 @@ int main(int argc, char** argv) {
       "extract_s\n");
   std::vector<double> scales = ParseList<double>(absl::GetFlag(FLAGS_scales));
   if (scales.empty()) {
-    scales.push_back(options.extractor.method == FeatureMethod::kDldSift
-                         ? options.extractor.dld.scale
-                         : options.extractor.rld.scale_space.scale_factor);
+    switch (options.extractor.method) {
+      case FeatureMethod::kDldSift:
+        scales.push_back(options.extractor.dld.scale);
+        break;
+      case FeatureMethod::kLdSift:
+        scales.push_back(options.extractor.ld.scale_space.scale_factor);
+        break;
+      case FeatureMethod::kRldSift:
+        scales.push_back(options.extractor.rld.scale_space.scale_factor);
+        break;
+    }
   }
   for (double scale : scales) {
     // The method's scale knob: E for DLD-SIFT, C for the scale-space methods.

@@ -25,7 +25,9 @@ ABSL_FLAG(int,
           frame_samples,
           kDld.frame_samples_per_support,
           "dld: dense surface samples per support disc for the local PCA frame");
-ABSL_FLAG(double, frame_radius, kDld.frame_radius_factor,
+ABSL_FLAG(double,
+          frame_radius,
+          kDld.frame_radius_factor,
           "dld: the local frame uses the samples within this many times the support radius");
 ABSL_FLAG(int, rld_samples, kRld.num_samples, "rld: resample points (N_RLD)");
 ABSL_FLAG(int, rld_neighbors, kRld.neighbors, "rld: k of the k-nearest-neighbour graph");
@@ -101,7 +103,9 @@ absl::Status ApplyDescriptorFlags(SiftDescriptorOptions* descriptor) {
 
 void ApplyScaleSpaceFlags(ScaleSpaceOptions* scale_space) {
   scale_space->levels = absl::GetFlag(FLAGS_levels);
-  scale_space->scale_factor = absl::GetFlag(FLAGS_scale_factor);
+  if (absl::GetFlag(FLAGS_scale_factor) != 0) {
+    scale_space->scale_factor = absl::GetFlag(FLAGS_scale_factor);
+  }
 }
 
 }  // namespace

@@ -36,10 +36,12 @@ TEST(RldSiftOptionsTest, DefaultsArePinnedAndValid) {
   EXPECT_EQ(rld.num_samples, 15000);  // the paper's N_RLD
   EXPECT_EQ(rld.neighbors, 10);       // and k
   EXPECT_EQ(rld.scale_space.levels, 20);
+  EXPECT_EQ(rld.scale_space.scale_factor, 15.0);  // measured on McGill (rld_sift.h)
   EXPECT_TRUE(rld.two_views);
   EXPECT_TRUE(rld.Validate().ok());
   const LdSiftOptions ld;
   EXPECT_EQ(ld.descriptor.orientation, ImageOrientation::kUpAxis);  // the original's descriptor
+  EXPECT_EQ(ld.scale_space.scale_factor, 20.0);                       // measured on McGill
   EXPECT_TRUE(ld.Validate().ok());
   RldSiftOptions bad;
   bad.neighbors = 0;
