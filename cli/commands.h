@@ -5,11 +5,28 @@
 
 #include <string>
 
+#include <vector>
+
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "common/pipeline/retrieval_pipeline.h"
 
 namespace meshseek::cli {
 
 absl::Status RunEval();
+absl::Status RunIngest();
+absl::Status RunBuild();
+absl::Status RunQuery(const std::string& model_path);
+absl::Status RunStatus();
+absl::Status RunServe();
+
+// eval's two paths: --server=in-process runs the pipeline in this process;
+// otherwise the models go through the coordinator (client_commands.cc).
+bool EvalInProcess();
+absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
+    const std::vector<ManifestEntry>& models,
+    const RetrievalPipelineOptions& options,
+    const std::string& manifest_path);
 absl::Status RunSynth();
 absl::Status RunInspect(const std::string& model_path);
 

@@ -33,7 +33,9 @@ absl::Status RunEval() {
                FeatureMethodName(options.extractor.method),
                ResolveThreadCount(options.num_threads));
   MESHSEEK_ASSIGN_OR_RETURN(const CollectionEvaluation evaluation,
-                            EvaluateCollection(models, options));
+                            EvalInProcess()
+                                ? EvaluateCollection(models, options)
+                                : EvaluateThroughServices(models, options, manifest_path));
   MESHSEEK_RETURN_IF_ERROR(WriteEvaluation(evaluation, options, out_dir));
 
   const StageTimings& t = evaluation.timings;
@@ -42,8 +44,11 @@ absl::Status RunEval() {
               100 * evaluation.metrics.micro.rp_excl,
               100 * evaluation.metrics.macro.rp_excl);
   std::printf(
-      "%zu models, codebook V = %zu; time %.1f s (extract %.1f, codebook %.1f, encode %.1f, rank "
-      "%.1f)\n",
+      EvalInProcess()
+          ? "%zu models, codebook V = %zu; time %.1f s (extract %.1f, codebook %.1f, encode %.1f, "
+            "rank %.1f)\n"
+          : "%zu models, codebook V = %zu; time %.1f s (ingest+extract %.1f, codebook+encode+index "
+            "%.1f, -, distances+metrics %.1f)\n",
       evaluation.models.size(),
       evaluation.codebook_size,
       t.total_seconds,

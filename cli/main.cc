@@ -25,12 +25,26 @@ namespace {
 
 constexpr char kUsage[] = R"(meshseek: 3-D shape retrieval with local depth-image SIFT features.
 
+Every command below talks gRPC to a coordinator: --server HOST:PORT, or, by
+default, an embedded stack of all services started for the command with its
+state in --data_dir (default ./meshseek-data).
+
 Commands:
-  eval   Extract local features of every model of a labelled collection, learn a
-         codebook on them, rank all pairs by symmetric KL divergence and evaluate:
+  eval   Ingest every model of a labelled collection, learn a codebook on their
+         local features, index them, rank all pairs by symmetric KL divergence
+         and evaluate:
            meshseek eval --manifest FILE --method dld --out DIR
          writes DIR/distances.bin (N x N float32, manifest order) and
-         DIR/metrics.json, and prints the metrics table.
+         DIR/metrics.json, and prints the metrics table. --server in-process
+         runs the same pipeline without services (the benchmark reference).
+  ingest Add models to a collection (created with the method flags if new):
+           meshseek ingest --collection C --manifest FILE | --folder DIR
+  build  Train the collection's codebook and index every model:
+           meshseek build --collection C
+  query  Rank a collection's models by similarity to a mesh:
+           meshseek query MODEL --collection C --top_k 10
+  status Show a collection, or follow a job: meshseek status --collection C | --job ID
+  serve  Run the embedded stack until Ctrl-C: meshseek serve --port 50051
   synth  Write the built-in labelled synthetic benchmark (procedural shapes):
            meshseek synth --out DIR
          writes DIR/manifest.csv, DIR/synthetic.cla and DIR/models/.
@@ -56,7 +70,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string command = args[1];
-  const std::size_t positional = command == "inspect" ? 3 : 2;
+  const std::size_t positional = command == "inspect" || command == "query" ? 3 : 2;
   if (args.size() > positional) {
     return Fail(absl::InvalidArgumentError(
         absl::StrCat("unexpected argument '", args[positional], "' (options are --flags)")));
@@ -70,9 +84,20 @@ int main(int argc, char** argv) {
   } else if (command == "inspect") {
     status = args.size() < 3 ? absl::InvalidArgumentError("inspect needs a MODEL file")
                              : meshseek::cli::RunInspect(args[2]);
+  } else if (command == "ingest") {
+    status = meshseek::cli::RunIngest();
+  } else if (command == "build") {
+    status = meshseek::cli::RunBuild();
+  } else if (command == "query") {
+    status = meshseek::cli::RunQuery(args.size() < 3 ? "" : args[2]);
+  } else if (command == "status") {
+    status = meshseek::cli::RunStatus();
+  } else if (command == "serve") {
+    status = meshseek::cli::RunServe();
   } else {
-    status = absl::InvalidArgumentError(
-        absl::StrCat("unknown command '", command, "' (commands: eval, synth, inspect)"));
+    status = absl::InvalidArgumentError(absl::StrCat(
+        "unknown command '", command,
+        "' (commands: eval, ingest, build, query, status, serve, synth, inspect)"));
   }
   return status.ok() ? 0 : Fail(status);
 }

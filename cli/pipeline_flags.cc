@@ -5,6 +5,7 @@
 #include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
 #include "common/base/status_macros.h"
+#include "common/rpc/convert.h"
 
 namespace {
 const meshseek::RetrievalPipelineOptions kDefaults;
@@ -34,8 +35,9 @@ ABSL_FLAG(int, rld_neighbors, kRld.neighbors, "rld: k of the k-nearest-neighbour
 ABSL_FLAG(int, levels, kRld.scale_space.levels, "ld, rld: scale-space levels L");
 ABSL_FLAG(double,
           scale_factor,
-          kRld.scale_space.scale_factor,
-          "ld, rld: C in the feature scale s = C * d * sqrt(level)");
+          0,
+          "ld, rld: C in the feature scale s = C * d * sqrt(level); 0 keeps each "
+          "method's measured default (ld 20, rld 15)");
 ABSL_FLAG(bool,
           weighted_frame,
           kDld.weighted_frame,
@@ -75,68 +77,42 @@ ABSL_FLAG(int, threads, kDefaults.num_threads, "threads (0: all cores)");
 ABSL_FLAG(bool, progress, true, "show progress bars on stderr");
 
 namespace meshseek::cli {
-namespace {
 
-absl::Status ApplyDescriptorFlags(SiftDescriptorOptions* descriptor) {
-  const std::string orientation = absl::GetFlag(FLAGS_orientation);
-  if (orientation == "dominant") {
-    descriptor->orientation = ImageOrientation::kDominant;
-  } else if (orientation == "up") {
-    descriptor->orientation = ImageOrientation::kUpAxis;
-  } else if (!orientation.empty()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--orientation must be 'dominant' or 'up', got '", orientation, "'"));
-  }
-  const std::string gray = absl::GetFlag(FLAGS_depth_to_gray);
-  if (gray == "fixed") {
-    descriptor->depth_to_gray = DepthToGray::kFixedRange;
-  } else if (gray == "stretch") {
-    descriptor->depth_to_gray = DepthToGray::kStretch;
-  } else if (!gray.empty()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--depth_to_gray must be 'fixed' or 'stretch', got '", gray, "'"));
-  }
-  descriptor->blur_sigma = absl::GetFlag(FLAGS_blur_sigma);
-  descriptor->max_orientations = absl::GetFlag(FLAGS_max_orientations);
-  return absl::OkStatus();
+v1::PipelineParams PipelineParamsFromFlags() {
+  v1::PipelineParams p;
+  const std::string method = absl::GetFlag(FLAGS_method);
+  p.set_method(method == "ld"    ? v1::FEATURE_METHOD_LD
+               : method == "rld" ? v1::FEATURE_METHOD_RLD
+               : method == "dld" ? v1::FEATURE_METHOD_DLD
+                                 : v1::FeatureMethod(-1));  // rejected with the name below
+  p.set_scale(absl::GetFlag(FLAGS_scale));
+  p.set_num_points(absl::GetFlag(FLAGS_points));
+  p.set_frame_samples_per_support(absl::GetFlag(FLAGS_frame_samples));
+  p.set_frame_radius_factor(absl::GetFlag(FLAGS_frame_radius));
+  p.set_weighted_frame(absl::GetFlag(FLAGS_weighted_frame));
+  p.set_rld_samples(absl::GetFlag(FLAGS_rld_samples));
+  p.set_rld_neighbors(absl::GetFlag(FLAGS_rld_neighbors));
+  p.set_levels(absl::GetFlag(FLAGS_levels));
+  p.set_ld_scale_factor(absl::GetFlag(FLAGS_scale_factor));
+  p.set_rld_scale_factor(absl::GetFlag(FLAGS_scale_factor));
+  p.set_image_size(absl::GetFlag(FLAGS_image_size));
+  p.set_orientation(absl::GetFlag(FLAGS_orientation));
+  p.set_depth_to_gray(absl::GetFlag(FLAGS_depth_to_gray));
+  p.set_blur_sigma(absl::GetFlag(FLAGS_blur_sigma));
+  p.set_max_orientations(absl::GetFlag(FLAGS_max_orientations));
+  p.set_vocabulary(absl::GetFlag(FLAGS_vocabulary));
+  p.set_kmeans_points_per_centroid(absl::GetFlag(FLAGS_kmeans_points_per_centroid));
+  p.set_kmeans_iterations(absl::GetFlag(FLAGS_kmeans_iterations));
+  p.set_seed(absl::GetFlag(FLAGS_seed));
+  p.set_kl_epsilon(absl::GetFlag(FLAGS_kl_epsilon));
+  return p;
 }
-
-void ApplyScaleSpaceFlags(ScaleSpaceOptions* scale_space) {
-  scale_space->levels = absl::GetFlag(FLAGS_levels);
-  if (absl::GetFlag(FLAGS_scale_factor) != 0) {
-    scale_space->scale_factor = absl::GetFlag(FLAGS_scale_factor);
-  }
-}
-
-}  // namespace
 
 absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags() {
-  RetrievalPipelineOptions options;
-  ExtractorOptions& extractor = options.extractor;
-  MESHSEEK_ASSIGN_OR_RETURN(extractor.method, ParseFeatureMethod(absl::GetFlag(FLAGS_method)));
-  extractor.dld.scale = absl::GetFlag(FLAGS_scale);
-  extractor.dld.num_points = absl::GetFlag(FLAGS_points);
-  extractor.dld.frame_samples_per_support = absl::GetFlag(FLAGS_frame_samples);
-  extractor.dld.weighted_frame = absl::GetFlag(FLAGS_weighted_frame);
-  extractor.dld.frame_radius_factor = absl::GetFlag(FLAGS_frame_radius);
-  extractor.rld.num_samples = absl::GetFlag(FLAGS_rld_samples);
-  extractor.rld.neighbors = absl::GetFlag(FLAGS_rld_neighbors);
-  extractor.rld.weighted_frame = absl::GetFlag(FLAGS_weighted_frame);
-  ApplyScaleSpaceFlags(&extractor.ld.scale_space);
-  ApplyScaleSpaceFlags(&extractor.rld.scale_space);
-  for (DepthImageOptions* image :
-       {&extractor.dld.depth_image, &extractor.ld.depth_image, &extractor.rld.depth_image}) {
-    image->image_size = absl::GetFlag(FLAGS_image_size);
-  }
-  for (SiftDescriptorOptions* descriptor :
-       {&extractor.dld.descriptor, &extractor.ld.descriptor, &extractor.rld.descriptor}) {
-    MESHSEEK_RETURN_IF_ERROR(ApplyDescriptorFlags(descriptor));
-  }
-  options.kmeans.num_centroids = absl::GetFlag(FLAGS_vocabulary);
-  options.kmeans.max_points_per_centroid = absl::GetFlag(FLAGS_kmeans_points_per_centroid);
-  options.kmeans.max_iterations = absl::GetFlag(FLAGS_kmeans_iterations);
-  options.kmeans.seed = absl::GetFlag(FLAGS_seed);
-  options.kl.epsilon = absl::GetFlag(FLAGS_kl_epsilon);
+  // Validates the method name first so the error names the flag.
+  MESHSEEK_RETURN_IF_ERROR(ParseFeatureMethod(absl::GetFlag(FLAGS_method)).status());
+  MESHSEEK_ASSIGN_OR_RETURN(RetrievalPipelineOptions options,
+                            rpc::PipelineOptionsFromParams(PipelineParamsFromFlags()));
   options.num_threads = absl::GetFlag(FLAGS_threads);
   options.show_progress = absl::GetFlag(FLAGS_progress);
   MESHSEEK_RETURN_IF_ERROR(options.Validate());

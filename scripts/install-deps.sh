@@ -9,6 +9,9 @@ PACKAGES=(
   libabsl-dev                                        # Status, flags, strings
   libopenmesh-dev                                    # mesh file readers
   libopencv-dev                                      # SIFT descriptor (features2d)
+  libflann-dev liblz4-dev                            # k-nearest-neighbour graph (RLD-SIFT)
+  libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # services
+  libsqlite3-dev                                     # state of the stateful services
   libgtest-dev libgmock-dev libbenchmark-dev         # tests and benchmarks
 )
 

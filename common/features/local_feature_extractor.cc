@@ -90,13 +90,15 @@ Json ExtractorOptions::ToJson() const {
 }
 
 absl::StatusOr<LocalFeatures> ExtractLocalFeatures(const TriangleMesh& mesh,
-                                                   const ExtractorOptions& options) {
+                                                   const ExtractorOptions& options,
+                                                   const PointGraph* resampled) {
   switch (options.method) {
     case FeatureMethod::kDldSift:
       return ExtractDldSift(mesh, options.dld);
     case FeatureMethod::kLdSift:
       return ExtractLdSift(mesh, options.ld);
     case FeatureMethod::kRldSift:
+      if (resampled != nullptr) return DescribeRldSift(mesh, *resampled, options.rld);
       return ExtractRldSift(mesh, options.rld);
   }
   return absl::InvalidArgumentError("unknown feature method");

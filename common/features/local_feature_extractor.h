@@ -43,9 +43,13 @@ struct ExtractorOptions {
 
 // Extracts the local features of one mesh with the selected method, on the
 // calling thread. LD-SIFT and RLD-SIFT may return an empty set (nothing
-// detected); DLD-SIFT always describes its points.
+// detected); DLD-SIFT always describes its points. For RLD-SIFT, `resampled`
+// may carry the graph ResampleSurfaceGraph made for this mesh with the
+// options' num_samples and neighbors (the resample service's output); the
+// result is the same as without it. Other methods ignore it.
 absl::StatusOr<LocalFeatures> ExtractLocalFeatures(const TriangleMesh& mesh,
-                                                   const ExtractorOptions& options);
+                                                   const ExtractorOptions& options,
+                                                   const PointGraph* resampled = nullptr);
 
 }  // namespace meshseek
 

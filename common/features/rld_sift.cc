@@ -24,25 +24,34 @@ absl::Status RldSiftOptions::Validate() const {
   return descriptor.Validate();
 }
 
-absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh,
-                                             const RldSiftOptions& options,
-                                             SurfacePoints* resampled,
-                                             std::vector<InterestPoint>* detected) {
+absl::StatusOr<PointGraph> ResampleSurfaceGraph(const TriangleMesh& mesh,
+                                                int num_samples,
+                                                int neighbors,
+                                                SurfacePoints* samples) {
+  MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));
+  MESHSEEK_ASSIGN_OR_RETURN(SurfacePoints points, SampleSurface(mesh, num_samples));
+  MESHSEEK_ASSIGN_OR_RETURN(PointGraph graph, SymmetricKnnGraph(points.positions, neighbors));
+  if (samples != nullptr) *samples = std::move(points);
+  return graph;
+}
+
+absl::StatusOr<LocalFeatures> DescribeRldSift(const TriangleMesh& mesh,
+                                              const PointGraph& graph,
+                                              const RldSiftOptions& options,
+                                              std::vector<InterestPoint>* detected) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));
-  MESHSEEK_ASSIGN_OR_RETURN(SurfacePoints samples, SampleSurface(mesh, options.num_samples));
-  MESHSEEK_ASSIGN_OR_RETURN(const PointGraph graph,
-                            SymmetricKnnGraph(samples.positions, options.neighbors));
+  MESHSEEK_RETURN_IF_ERROR(ValidatePointGraph(graph));
   std::vector<InterestPoint> points = DetectInterestPoints(graph, options.scale_space);
   LocalFeatures features;
   if (!points.empty()) {
-    const PointGrid grid(samples.positions, std::max(MedianScale(points), 1e-12f));
+    const PointGrid grid(graph.positions, std::max(MedianScale(points), 1e-12f));
     LocalDepthSift describer(mesh, options.depth_image, options.descriptor);
     std::vector<uint32_t> support;
     for (const InterestPoint& ip : points) {
-      const Vec3f& p = samples.positions[ip.vertex];
+      const Vec3f& p = graph.positions[ip.vertex];
       const auto axes =
-          SupportAxes(samples.positions, grid, p, ip.scale, options.weighted_frame, &support);
+          SupportAxes(graph.positions, grid, p, ip.scale, options.weighted_frame, &support);
       if (!axes) continue;
       describer.Describe({Vec3d(p), axes->axes[0], axes->axes[2], ip.scale},
                          options.two_views,
@@ -50,9 +59,19 @@ absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh,
                          &features);
     }
   }
-  if (resampled != nullptr) *resampled = std::move(samples);
   if (detected != nullptr) *detected = std::move(points);
   return features;
+}
+
+absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh,
+                                             const RldSiftOptions& options,
+                                             SurfacePoints* resampled,
+                                             std::vector<InterestPoint>* detected) {
+  MESHSEEK_RETURN_IF_ERROR(options.Validate());
+  MESHSEEK_ASSIGN_OR_RETURN(
+      const PointGraph graph,
+      ResampleSurfaceGraph(mesh, options.num_samples, options.neighbors, resampled));
+  return DescribeRldSift(mesh, graph, options, detected);
 }
 
 }  // namespace meshseek

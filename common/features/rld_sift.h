@@ -18,6 +18,7 @@
 #include "common/features/scale_space.h"
 #include "common/features/sift_descriptor.h"
 #include "common/geometry/mesh.h"
+#include "common/geometry/point_graph.h"
 #include "common/geometry/surface_sampler.h"
 
 namespace meshseek {
@@ -46,7 +47,25 @@ struct RldSiftOptions {
   absl::Status Validate() const;
 };
 
-// Extracts RLD-SIFT features. `resampled` and `detected`, if given, receive
+// Step 1 of RLD-SIFT, the resample service's work: `num_samples` area-uniform
+// Sobol points on the mesh joined to their `neighbors` nearest (symmetrised).
+// `samples`, if given, receives the points with normals and faces.
+absl::StatusOr<PointGraph> ResampleSurfaceGraph(const TriangleMesh& mesh,
+                                                int num_samples,
+                                                int neighbors,
+                                                SurfacePoints* samples = nullptr);
+
+// Step 2, the extract service's work: scale-space detection on `graph` (as
+// ResampleSurfaceGraph made it with options.num_samples and
+// options.neighbors) and two depth images of `mesh` per interest point. The
+// graph is checked (ValidatePointGraph); options.num_samples and neighbors
+// are not used.
+absl::StatusOr<LocalFeatures> DescribeRldSift(const TriangleMesh& mesh,
+                                              const PointGraph& graph,
+                                              const RldSiftOptions& options,
+                                              std::vector<InterestPoint>* detected = nullptr);
+
+// Extracts RLD-SIFT features: both steps. `resampled` and `detected`, if given, receive
 // the resample points and the interest points (vertex = resample index). A
 // model with no interest point gives an empty set, not an error.
 absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh,

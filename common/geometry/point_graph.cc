@@ -1,6 +1,7 @@
 #include "common/geometry/point_graph.h"
 
 #include <algorithm>
+#include <cmath>
 #include <flann/flann.hpp>
 
 #include "absl/strings/str_cat.h"
@@ -13,6 +14,40 @@ double PointGraph::MeanEdgeLength(std::size_t i) const {
   double sum = 0;
   for (const uint32_t j : nbrs) sum += Distance(Vec3d(positions[i]), Vec3d(positions[j]));
   return sum / nbrs.size();
+}
+
+absl::Status ValidatePointGraph(const PointGraph& graph) {
+  const std::size_t n = graph.positions.size();
+  if (graph.offsets.size() != n + 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "point graph: ", graph.offsets.size(), " offsets for ", n, " points (need ", n + 1, ")"));
+  }
+  if (graph.boundary.size() != n) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "point graph: ", graph.boundary.size(), " boundary flags for ", n, " points"));
+  }
+  if (graph.offsets[0] != 0 || graph.offsets[n] != graph.neighbors.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("point graph: offsets must run from 0 to the neighbour count ",
+                     graph.neighbors.size(), ", got ", graph.offsets[0], " to ", graph.offsets[n]));
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3f& p = graph.positions[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      return absl::InvalidArgumentError(absl::StrCat("point graph: point ", i, " is not finite"));
+    }
+    if (graph.offsets[i + 1] < graph.offsets[i]) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("point graph: offsets decrease at point ", i));
+    }
+    for (uint32_t k = graph.offsets[i]; k < graph.offsets[i + 1]; ++k) {
+      if (graph.neighbors[k] >= n || graph.neighbors[k] == i) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "point graph: point ", i, " has neighbour ", graph.neighbors[k], " (", n, " points)"));
+      }
+    }
+  }
+  return absl::OkStatus();
 }
 
 PointGraph MakePointGraph(std::vector<Vec3f> positions,

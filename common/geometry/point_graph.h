@@ -37,6 +37,13 @@ struct PointGraph {
 PointGraph MakePointGraph(std::vector<Vec3f> positions,
                           const std::vector<std::pair<uint32_t, uint32_t>>& edges);
 
+// Checks what a graph from outside (the resample service) must satisfy:
+// offsets of size n + 1 starting at 0, non-decreasing, ending at the
+// neighbour count; neighbours in range, not the point itself; finite
+// positions; boundary of size n. The message names the first
+// offending point.
+absl::Status ValidatePointGraph(const PointGraph& graph);
+
 // The symmetrised k-nearest-neighbour graph (Euclidean): i and j are joined
 // when either is among the other's k nearest (exact search, FLANN kd-tree;
 // ties by index). Needs more than k points.

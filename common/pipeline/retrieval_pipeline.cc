@@ -151,6 +151,25 @@ absl::StatusOr<std::vector<float>> RankCollection(const std::vector<std::vector<
   return distances;
 }
 
+absl::StatusOr<std::vector<float>> QueryDistances(const std::vector<float>& query,
+                                                  const std::vector<std::vector<float>>& histograms,
+                                                  const RetrievalPipelineOptions& options) {
+  std::vector<float> distances(histograms.size(), std::numeric_limits<float>::infinity());
+  if (query.empty()) return distances;
+  std::vector<std::size_t> present;
+  std::vector<std::vector<float>> compared;
+  for (std::size_t i = 0; i < histograms.size(); ++i) {
+    if (histograms[i].empty()) continue;
+    present.push_back(i);
+    compared.push_back(histograms[i]);
+  }
+  if (compared.empty()) return distances;
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<float> sub,
+                            SymmetricKlDistances(query, compared, options.kl, options.num_threads));
+  for (std::size_t a = 0; a < present.size(); ++a) distances[present[a]] = sub[a];
+  return distances;
+}
+
 absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<ManifestEntry>& models,
                                                         const RetrievalPipelineOptions& options) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());

@@ -74,6 +74,13 @@ absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
 absl::StatusOr<std::vector<float>> RankCollection(const std::vector<std::vector<float>>& histograms,
                                                   const RetrievalPipelineOptions& options);
 
+// Distances from one query histogram to each of `histograms` (the search
+// path), with the same rule for empty histograms as RankCollection: +infinity
+// to or from a model without features.
+absl::StatusOr<std::vector<float>> QueryDistances(const std::vector<float>& query,
+                                                  const std::vector<std::vector<float>>& histograms,
+                                                  const RetrievalPipelineOptions& options);
+
 struct StageTimings {
   double extract_seconds = 0;
   double codebook_seconds = 0;

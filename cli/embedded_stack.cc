@@ -1,0 +1,52 @@
+#include "cli/embedded_stack.h"
+
+#include "absl/strings/str_cat.h"
+#include "common/base/parallel.h"
+#include "common/base/status_macros.h"
+
+namespace meshseek::cli {
+
+absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(const std::string& data_dir,
+                                                                     int threads,
+                                                                     int coordinator_port) {
+  std::unique_ptr<EmbeddedStack> stack(new EmbeddedStack());
+  const int cores = ResolveThreadCount(threads);
+  rpc::ServerOptions server;
+  server.address = "127.0.0.1:0";
+  server.grace_period = absl::Seconds(2);
+  auto serve = [&](const char* name, grpc::Service* service) -> absl::StatusOr<std::string> {
+    MESHSEEK_ASSIGN_OR_RETURN(auto started, rpc::RpcServer::Start(name, {service}, server));
+    const std::string address = absl::StrCat("127.0.0.1:", started->port());
+    stack->servers_.push_back(std::move(started));
+    return address;
+  };
+  ExtractServiceOptions extract;
+  extract.workers = cores;
+  stack->extract_ = std::make_unique<ExtractService>(extract);
+  CodebookServiceOptions codebook{data_dir + "/codebook", cores};
+  MESHSEEK_ASSIGN_OR_RETURN(stack->codebook_, CodebookService::Create(codebook));
+  IndexServiceOptions index{data_dir + "/index", cores};
+  MESHSEEK_ASSIGN_OR_RETURN(stack->index_, IndexService::Create(index));
+
+  CoordinatorOptions coordinator;
+  coordinator.data_dir = data_dir + "/coordinator";
+  MESHSEEK_ASSIGN_OR_RETURN(coordinator.resample_target, serve("resample", &stack->resample_));
+  MESHSEEK_ASSIGN_OR_RETURN(coordinator.extract_target, serve("extract", stack->extract_.get()));
+  MESHSEEK_ASSIGN_OR_RETURN(coordinator.codebook_target, serve("codebook", stack->codebook_.get()));
+  MESHSEEK_ASSIGN_OR_RETURN(coordinator.index_target, serve("index", stack->index_.get()));
+  coordinator.max_in_flight = cores;
+  MESHSEEK_ASSIGN_OR_RETURN(stack->coordinator_, CoordinatorService::Create(coordinator));
+  server.address = absl::StrCat("127.0.0.1:", coordinator_port);
+  MESHSEEK_ASSIGN_OR_RETURN(stack->coordinator_address_,
+                            serve("coordinator", stack->coordinator_.get()));
+  return stack;
+}
+
+EmbeddedStack::~EmbeddedStack() {
+  // The coordinator first (it calls the others), then its background work.
+  if (!servers_.empty()) servers_.back()->Shutdown();
+  if (coordinator_) coordinator_->Stop();
+  for (auto& server : servers_) server->Shutdown();
+}
+
+}  // namespace meshseek::cli

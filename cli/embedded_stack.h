@@ -1,0 +1,49 @@
+// The embedded default: every meshseek service in this process, each a real
+// gRPC server on a loopback port, with state under one data folder
+// (DATA/codebook, DATA/index, DATA/coordinator). The CLI starts it when no
+// --server is given, talks to it over gRPC exactly as to a cluster, and stops
+// it at exit; state persists between runs. `meshseek serve` keeps it running.
+#ifndef MESHSEEK_CLI_EMBEDDED_STACK_H_
+#define MESHSEEK_CLI_EMBEDDED_STACK_H_
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "common/rpc/server.h"
+#include "services/codebook/codebook_service.h"
+#include "services/coordinator/coordinator_service.h"
+#include "services/extract/extract_service.h"
+#include "services/index/index_service.h"
+#include "services/resample/resample_service.h"
+
+namespace meshseek::cli {
+
+class EmbeddedStack {
+ public:
+  /// Starts the five services; the coordinator listens on `coordinator_port`
+  /// (0: any free port) on 127.0.0.1, the others on free loopback ports.
+  /// `threads`: extraction slots and coordinator in-flight models (<= 0: cores).
+  static absl::StatusOr<std::unique_ptr<EmbeddedStack>> Start(const std::string& data_dir,
+                                                               int threads,
+                                                               int coordinator_port = 0);
+  ~EmbeddedStack();
+
+  /// "127.0.0.1:PORT" of the coordinator.
+  const std::string& coordinator_address() const { return coordinator_address_; }
+
+ private:
+  EmbeddedStack() = default;
+  ResampleService resample_;
+  std::unique_ptr<ExtractService> extract_;
+  std::unique_ptr<CodebookService> codebook_;
+  std::unique_ptr<IndexService> index_;
+  std::unique_ptr<CoordinatorService> coordinator_;
+  std::vector<std::unique_ptr<rpc::RpcServer>> servers_;  // coordinator last
+  std::string coordinator_address_;
+};
+
+}  // namespace meshseek::cli
+
+#endif  // MESHSEEK_CLI_EMBEDDED_STACK_H_

@@ -1,0 +1,58 @@
+// Client side of every meshseek call: channels and retries set up one way.
+//
+// A channel target is any gRPC target: "host:port" or "dns:///extract:50051"
+// (every address the name resolves to, re-resolved when connections close,
+// which the servers' max connection age makes happen), or
+// "ipv4:127.0.0.1:7001,127.0.0.1:7002" (a fixed list, as the tests use).
+// Calls are spread over all addresses by round_robin, and the client's
+// health checking (grpc.health.v1) skips replicas that say NOT_SERVING.
+#ifndef MESHSEEK_COMMON_RPC_CLIENT_H_
+#define MESHSEEK_COMMON_RPC_CLIENT_H_
+
+#include <grpcpp/grpcpp.h>
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/time/time.h"
+
+namespace meshseek::rpc {
+
+struct ChannelOptions {
+  /// Largest message sent or received.
+  int max_message_bytes = 64 << 20;
+  /// Fully qualified service (e.g. "meshseek.v1.Extract") whose calls gRPC
+  /// itself retries on UNAVAILABLE, on another replica when there is one.
+  /// Only for services whose every method is idempotent; empty: none.
+  std::string retry_service;
+  /// Attempts of such a retry, 2-5.
+  int max_attempts = 4;
+};
+
+std::shared_ptr<grpc::Channel> MakeChannel(const std::string& target,
+                                           const ChannelOptions& options = {});
+
+// Sets a deadline `timeout` from now on `context`. Every call gets one.
+void SetDeadline(grpc::ClientContext* context, absl::Duration timeout);
+
+struct RetryOptions {
+  /// Tries in all.
+  int attempts = 8;
+  /// First pause, doubled after each failure up to max_backoff.
+  absl::Duration initial_backoff = absl::Milliseconds(100);
+  absl::Duration max_backoff = absl::Seconds(5);
+};
+
+// Runs `call` until it succeeds, fails with a code that is not transient
+// (IsTransient), or has been tried `options.attempts` times; returns the last
+// status. Only for idempotent calls. Stops early when `stop` becomes true.
+absl::Status RetryTransient(const std::function<absl::Status()>& call,
+                            const RetryOptions& options = {},
+                            const std::atomic<bool>* stop = nullptr);
+
+}  // namespace meshseek::rpc
+
+#endif  // MESHSEEK_COMMON_RPC_CLIENT_H_

@@ -1,0 +1,287 @@
+#include "common/rpc/convert.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
+#include "common/base/file_io.h"
+#include "common/base/status_macros.h"
+#include "common/geometry/mesh_io.h"
+
+namespace meshseek::rpc {
+namespace {
+
+const char* ExtensionOf(v1::MeshFormat format) {
+  switch (format) {
+    case v1::MESH_FORMAT_OFF: return ".off";
+    case v1::MESH_FORMAT_OBJ: return ".obj";
+    case v1::MESH_FORMAT_PLY: return ".ply";
+    case v1::MESH_FORMAT_STL: return ".stl";
+    default: return nullptr;
+  }
+}
+
+// Reads a mesh file sent as bytes with the same readers as files on disk, via
+// a private temporary file (OpenMesh's readers take paths).
+absl::StatusOr<TriangleMesh> ReadMeshFile(const v1::MeshFile& file) {
+  const std::string name = file.name().empty() ? "mesh file" : file.name();
+  std::string extension;
+  if (const char* ext = ExtensionOf(file.format())) {
+    extension = ext;
+  } else {
+    MESHSEEK_ASSIGN_OR_RETURN(const MeshFormat format, MeshFormatFromPath(name));
+    extension = absl::StrCat(".", MeshFormatName(format));
+  }
+  const char* tmp = std::getenv("TMPDIR");
+  std::string path = absl::StrCat(tmp ? tmp : "/tmp", "/meshseek-mesh-XXXXXX", extension);
+  const int fd = mkstemps(path.data(), static_cast<int>(extension.size()));
+  if (fd < 0) return absl::InternalError(absl::StrCat("cannot create a temporary file for ", name));
+  close(fd);
+  absl::Status written = WriteStringToFile(path, file.data());
+  absl::StatusOr<TriangleMesh> mesh =
+      written.ok() ? ReadMesh(path) : absl::StatusOr<TriangleMesh>(written);
+  std::remove(path.c_str());
+  if (!mesh.ok()) {
+    return absl::Status(mesh.status().code(),
+                        absl::StrReplaceAll(mesh.status().message(), {{path, name}}));
+  }
+  return mesh;
+}
+
+}  // namespace
+
+absl::StatusOr<TriangleMesh> MeshFromProto(const v1::MeshInput& input) {
+  TriangleMesh mesh;
+  switch (input.source_case()) {
+    case v1::MeshInput::kFile: {
+      MESHSEEK_ASSIGN_OR_RETURN(mesh, ReadMeshFile(input.file()));
+      break;
+    }
+    case v1::MeshInput::kMesh: {
+      const v1::Mesh& m = input.mesh();
+      if (m.vertices_size() % 3 != 0 || m.triangles_size() % 3 != 0) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("mesh: ", m.vertices_size(), " vertex values and ", m.triangles_size(),
+                         " triangle indices; both must be multiples of 3"));
+      }
+      mesh.vertices.resize(m.vertices_size() / 3);
+      for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+        mesh.vertices[i] = Vec3f(m.vertices(3 * i), m.vertices(3 * i + 1), m.vertices(3 * i + 2));
+      }
+      mesh.triangles.resize(m.triangles_size() / 3);
+      for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+        mesh.triangles[t] = {m.triangles(3 * t), m.triangles(3 * t + 1), m.triangles(3 * t + 2)};
+      }
+      break;
+    }
+    default:
+      return absl::InvalidArgumentError("mesh: neither arrays nor a file were given");
+  }
+  if (absl::Status valid = ValidateMesh(mesh); !valid.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("mesh: ", valid.message()));
+  }
+  return mesh;
+}
+
+void MeshToProto(const TriangleMesh& mesh, v1::Mesh* out) {
+  out->Clear();
+  out->mutable_vertices()->Reserve(static_cast<int>(3 * mesh.vertices.size()));
+  for (const Vec3f& v : mesh.vertices) {
+    out->add_vertices(v.x);
+    out->add_vertices(v.y);
+    out->add_vertices(v.z);
+  }
+  out->mutable_triangles()->Reserve(static_cast<int>(3 * mesh.triangles.size()));
+  for (const Triangle& t : mesh.triangles) {
+    for (uint32_t v : t) out->add_triangles(v);
+  }
+}
+
+absl::StatusOr<LocalFeatures> FeaturesFromProto(const v1::LocalFeatures& f) {
+  const std::size_t n = f.count();
+  if (f.dimension() != kSiftDimension && n > 0) {
+    return absl::InvalidArgumentError(absl::StrCat("local features: descriptor dimension ",
+                                                   f.dimension(), ", expected ", kSiftDimension));
+  }
+  if (f.descriptors().size() != n * kSiftDimension) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("local features: ", f.descriptors().size(), " descriptor bytes for ", n,
+                     " features of ", kSiftDimension, " (need ", n * kSiftDimension, ")"));
+  }
+  const bool has_keypoints = f.positions_size() > 0;
+  if (has_keypoints &&
+      (static_cast<std::size_t>(f.positions_size()) != 3 * n ||
+       static_cast<std::size_t>(f.views_size()) != 3 * n ||
+       static_cast<std::size_t>(f.ups_size()) != 3 * n ||
+       static_cast<std::size_t>(f.scales_size()) != n ||
+       static_cast<std::size_t>(f.levels_size()) != n)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("local features: keypoint arrays do not match the count ", n));
+  }
+  LocalFeatures features;
+  features.descriptors.assign(f.descriptors().begin(), f.descriptors().end());
+  features.keypoints.resize(n);
+  if (has_keypoints) {
+    for (std::size_t i = 0; i < n; ++i) {
+      Keypoint& k = features.keypoints[i];
+      k.position = Vec3f(f.positions(3 * i), f.positions(3 * i + 1), f.positions(3 * i + 2));
+      k.view = Vec3f(f.views(3 * i), f.views(3 * i + 1), f.views(3 * i + 2));
+      k.up = Vec3f(f.ups(3 * i), f.ups(3 * i + 1), f.ups(3 * i + 2));
+      k.scale = f.scales(i);
+      k.level = f.levels(i);
+    }
+  }
+  return features;
+}
+
+void FeaturesToProto(const LocalFeatures& features, v1::LocalFeatures* out) {
+  out->Clear();
+  out->set_count(static_cast<uint32_t>(features.size()));
+  out->set_dimension(kSiftDimension);
+  out->set_descriptors(features.descriptors.data(), features.descriptors.size());
+  for (const Keypoint& k : features.keypoints) {
+    for (const Vec3f* v : {&k.position, &k.view, &k.up}) {
+      auto* field = v == &k.position ? out->mutable_positions()
+                    : v == &k.view   ? out->mutable_views()
+                                     : out->mutable_ups();
+      field->Add(v->x);
+      field->Add(v->y);
+      field->Add(v->z);
+    }
+    out->add_scales(k.scale);
+    out->add_levels(k.level);
+  }
+}
+
+absl::StatusOr<PointGraph> GraphFromProto(const v1::PointGraph& g) {
+  if (g.positions_size() % 3 != 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("point graph: ", g.positions_size(), " position values, not a multiple of 3"));
+  }
+  PointGraph graph;
+  graph.positions.resize(g.positions_size() / 3);
+  for (std::size_t i = 0; i < graph.positions.size(); ++i) {
+    graph.positions[i] = Vec3f(g.positions(3 * i), g.positions(3 * i + 1), g.positions(3 * i + 2));
+  }
+  graph.offsets.assign(g.offsets().begin(), g.offsets().end());
+  graph.neighbors.assign(g.neighbors().begin(), g.neighbors().end());
+  graph.boundary.assign(graph.positions.size(), 0);
+  MESHSEEK_RETURN_IF_ERROR(ValidatePointGraph(graph));
+  return graph;
+}
+
+void GraphToProto(const PointGraph& graph, v1::PointGraph* out) {
+  out->Clear();
+  out->mutable_positions()->Reserve(static_cast<int>(3 * graph.size()));
+  for (const Vec3f& p : graph.positions) {
+    out->add_positions(p.x);
+    out->add_positions(p.y);
+    out->add_positions(p.z);
+  }
+  out->mutable_offsets()->Add(graph.offsets.begin(), graph.offsets.end());
+  out->mutable_neighbors()->Add(graph.neighbors.begin(), graph.neighbors.end());
+}
+
+absl::StatusOr<std::vector<float>> HistogramFromProto(const v1::SparseHistogram& h) {
+  if (h.bins_size() != h.weights_size()) {
+    return absl::InvalidArgumentError(absl::StrCat("histogram: ", h.bins_size(), " bins but ",
+                                                   h.weights_size(), " weights"));
+  }
+  if (h.bins_size() == 0) return std::vector<float>();
+  std::vector<float> dense(h.size(), 0.0f);
+  for (int i = 0; i < h.bins_size(); ++i) {
+    if (h.bins(i) >= h.size() || (i > 0 && h.bins(i) <= h.bins(i - 1))) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "histogram: bin ", h.bins(i), " at position ", i,
+          " is out of order or not below the vocabulary size ", h.size()));
+    }
+    if (!std::isfinite(h.weights(i)) || h.weights(i) < 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("histogram: bin ", h.bins(i), " has weight ", h.weights(i)));
+    }
+    dense[h.bins(i)] = h.weights(i);
+  }
+  return dense;
+}
+
+void HistogramToProto(const std::vector<float>& dense,
+                      std::size_t vocabulary_size,
+                      v1::SparseHistogram* out) {
+  out->Clear();
+  out->set_size(static_cast<uint32_t>(vocabulary_size));
+  for (std::size_t i = 0; i < dense.size(); ++i) {
+    if (dense[i] != 0.0f) {
+      out->add_bins(static_cast<uint32_t>(i));
+      out->add_weights(dense[i]);
+    }
+  }
+}
+
+absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromParams(const v1::PipelineParams& p) {
+  RetrievalPipelineOptions options;
+  ExtractorOptions& extractor = options.extractor;
+  switch (p.method()) {
+    case v1::FEATURE_METHOD_UNSPECIFIED:
+    case v1::FEATURE_METHOD_DLD: extractor.method = FeatureMethod::kDldSift; break;
+    case v1::FEATURE_METHOD_LD: extractor.method = FeatureMethod::kLdSift; break;
+    case v1::FEATURE_METHOD_RLD: extractor.method = FeatureMethod::kRldSift; break;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat("params: unknown method ", p.method()));
+  }
+  // Zero means "the default": keep the option's own value.
+  auto set = [](auto value, auto* field) {
+    if (value != 0) *field = value;
+  };
+  set(p.scale(), &extractor.dld.scale);
+  set(p.num_points(), &extractor.dld.num_points);
+  set(p.frame_samples_per_support(), &extractor.dld.frame_samples_per_support);
+  set(p.frame_radius_factor(), &extractor.dld.frame_radius_factor);
+  if (p.has_weighted_frame()) {
+    extractor.dld.weighted_frame = p.weighted_frame();
+    extractor.rld.weighted_frame = p.weighted_frame();
+  }
+  set(p.rld_samples(), &extractor.rld.num_samples);
+  set(p.rld_neighbors(), &extractor.rld.neighbors);
+  set(p.levels(), &extractor.ld.scale_space.levels);
+  set(p.levels(), &extractor.rld.scale_space.levels);
+  set(p.ld_scale_factor(), &extractor.ld.scale_space.scale_factor);
+  set(p.rld_scale_factor(), &extractor.rld.scale_space.scale_factor);
+  for (DepthImageOptions* image :
+       {&extractor.dld.depth_image, &extractor.ld.depth_image, &extractor.rld.depth_image}) {
+    set(p.image_size(), &image->image_size);
+  }
+  for (SiftDescriptorOptions* d :
+       {&extractor.dld.descriptor, &extractor.ld.descriptor, &extractor.rld.descriptor}) {
+    if (p.orientation() == "dominant") {
+      d->orientation = ImageOrientation::kDominant;
+    } else if (p.orientation() == "up") {
+      d->orientation = ImageOrientation::kUpAxis;
+    } else if (!p.orientation().empty()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "params: orientation must be 'dominant' or 'up', got '", p.orientation(), "'"));
+    }
+    if (p.depth_to_gray() == "fixed") {
+      d->depth_to_gray = DepthToGray::kFixedRange;
+    } else if (p.depth_to_gray() == "stretch") {
+      d->depth_to_gray = DepthToGray::kStretch;
+    } else if (!p.depth_to_gray().empty()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "params: depth_to_gray must be 'fixed' or 'stretch', got '", p.depth_to_gray(), "'"));
+    }
+    set(p.blur_sigma(), &d->blur_sigma);
+    set(p.max_orientations(), &d->max_orientations);
+  }
+  set(p.vocabulary(), &options.kmeans.num_centroids);
+  set(p.kmeans_points_per_centroid(), &options.kmeans.max_points_per_centroid);
+  set(p.kmeans_iterations(), &options.kmeans.max_iterations);
+  set(p.seed(), &options.kmeans.seed);
+  set(p.kl_epsilon(), &options.kl.epsilon);
+  MESHSEEK_RETURN_IF_ERROR(options.Validate());
+  return options;
+}
+
+}  // namespace meshseek::rpc

@@ -1,0 +1,47 @@
+// Protobuf messages (proto/meshseek/v1) <-> the algorithm core's types.
+// Every conversion from the wire checks what the core relies on and returns
+// InvalidArgument naming the field and the bad value; conversions to the wire
+// cannot fail.
+#ifndef MESHSEEK_COMMON_RPC_CONVERT_H_
+#define MESHSEEK_COMMON_RPC_CONVERT_H_
+
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "common/features/local_features.h"
+#include "common/geometry/mesh.h"
+#include "common/geometry/point_graph.h"
+#include "common/pipeline/retrieval_pipeline.h"
+#include "meshseek/v1/types.pb.h"
+
+namespace meshseek::rpc {
+
+// A mesh from arrays or from a file's bytes (read by the same readers as
+// ReadMesh; errors name the file by MeshFile.name). Validated (ValidateMesh).
+absl::StatusOr<TriangleMesh> MeshFromProto(const v1::MeshInput& input);
+void MeshToProto(const TriangleMesh& mesh, v1::Mesh* out);
+
+absl::StatusOr<LocalFeatures> FeaturesFromProto(const v1::LocalFeatures& features);
+void FeaturesToProto(const LocalFeatures& features, v1::LocalFeatures* out);
+
+// Checked with ValidatePointGraph; boundary flags are all 0 (point clouds).
+absl::StatusOr<PointGraph> GraphFromProto(const v1::PointGraph& graph);
+void GraphToProto(const PointGraph& graph, v1::PointGraph* out);
+
+// Dense histogram of length size (empty when the message has no bins: a model
+// without features). Bins must increase strictly and be < size; weights finite
+// and non-negative.
+absl::StatusOr<std::vector<float>> HistogramFromProto(const v1::SparseHistogram& histogram);
+// The non-zero bins of `dense` (length = vocabulary size; empty = no features).
+void HistogramToProto(const std::vector<float>& dense,
+                      std::size_t vocabulary_size,
+                      v1::SparseHistogram* out);
+
+// Pipeline options from parameters: zero or unset fields take the core's
+// defaults. Validated (RetrievalPipelineOptions::Validate).
+absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromParams(const v1::PipelineParams& params);
+
+}  // namespace meshseek::rpc
+
+#endif  // MESHSEEK_COMMON_RPC_CONVERT_H_

@@ -1,0 +1,125 @@
+#include "common/rpc/convert.h"
+
+#include <string>
+
+#include "common/geometry/test_meshes.h"
+#include "gtest/gtest.h"
+
+namespace meshseek::rpc {
+namespace {
+
+TEST(ConvertTest, MeshRoundTripsExactly) {
+  const TriangleMesh cube = testing_meshes::Cube(0.75f);
+  v1::MeshInput input;
+  MeshToProto(cube, input.mutable_mesh());
+  auto back = MeshFromProto(input);
+  ASSERT_TRUE(back.ok()) << back.status();
+  ASSERT_EQ(back->vertices.size(), cube.vertices.size());
+  for (std::size_t i = 0; i < cube.vertices.size(); ++i) {
+    EXPECT_EQ(back->vertices[i].x, cube.vertices[i].x);
+    EXPECT_EQ(back->vertices[i].z, cube.vertices[i].z);
+  }
+  EXPECT_EQ(back->triangles, cube.triangles);
+}
+
+TEST(ConvertTest, BadMeshesAreInvalidArgumentNamingTheProblem) {
+  v1::MeshInput input;
+  EXPECT_EQ(MeshFromProto(input).status().code(), absl::StatusCode::kInvalidArgument);
+  MeshToProto(testing_meshes::Cube(), input.mutable_mesh());
+  input.mutable_mesh()->set_triangles(4, 999);
+  const absl::Status out_of_range = MeshFromProto(input).status();
+  EXPECT_EQ(out_of_range.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(out_of_range.message().find("999"), std::string::npos) << out_of_range;
+  input.mutable_mesh()->add_vertices(1.0f);  // not a multiple of 3
+  EXPECT_NE(MeshFromProto(input).status().message().find("multiples of 3"), std::string::npos);
+}
+
+TEST(ConvertTest, MeshFileBytesAreReadByTheFileReaders) {
+  v1::MeshInput input;
+  input.mutable_file()->set_name("tetra.off");
+  input.mutable_file()->set_data("OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+                                 "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  auto mesh = MeshFromProto(input);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->triangles.size(), 4u);
+  input.mutable_file()->set_data("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 7\n");
+  const absl::Status bad = MeshFromProto(input).status();
+  EXPECT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("tetra.off"), std::string::npos) << bad;
+  input.mutable_file()->set_name("model.xyz");
+  EXPECT_EQ(MeshFromProto(input).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(ConvertTest, FeaturesRoundTripAndWrongDescriptorSizesAreRejected) {
+  LocalFeatures features;
+  features.keypoints.resize(2);
+  features.keypoints[1].position = Vec3f(1, 2, 3);
+  features.keypoints[1].scale = 0.5f;
+  features.keypoints[1].level = 7;
+  features.descriptors.assign(2 * kSiftDimension, 9);
+  v1::LocalFeatures proto;
+  FeaturesToProto(features, &proto);
+  auto back = FeaturesFromProto(proto);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->descriptors, features.descriptors);
+  EXPECT_EQ(back->keypoints[1].position.y, 2.0f);
+  EXPECT_EQ(back->keypoints[1].level, 7);
+  proto.mutable_descriptors()->pop_back();
+  const absl::Status short_descriptors = FeaturesFromProto(proto).status();
+  EXPECT_EQ(short_descriptors.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(short_descriptors.message().find("255 descriptor bytes"), std::string::npos)
+      << short_descriptors;
+  FeaturesToProto(features, &proto);
+  proto.set_dimension(64);
+  EXPECT_NE(FeaturesFromProto(proto).status().message().find("dimension 64"), std::string::npos);
+}
+
+TEST(ConvertTest, GraphsAreCheckedOnArrival) {
+  PointGraph graph = MakePointGraph({Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)},
+                                    {{0, 1}, {1, 2}});
+  v1::PointGraph proto;
+  GraphToProto(graph, &proto);
+  auto back = GraphFromProto(proto);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->neighbors, graph.neighbors);
+  proto.set_neighbors(0, 5);
+  EXPECT_EQ(GraphFromProto(proto).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(ConvertTest, HistogramsAreSparseAndExact) {
+  const std::vector<float> dense = {0.0f, 0.25f, 0.0f, 0.75f};
+  v1::SparseHistogram proto;
+  HistogramToProto(dense, dense.size(), &proto);
+  EXPECT_EQ(proto.bins_size(), 2);
+  auto back = HistogramFromProto(proto);
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(*back, dense);
+  HistogramToProto({}, 4, &proto);
+  EXPECT_TRUE(HistogramFromProto(proto)->empty());  // a model without features
+  proto.add_bins(4);
+  proto.add_weights(1.0f);
+  EXPECT_EQ(HistogramFromProto(proto).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(ConvertTest, UnsetParamsAreTheCoreDefaults) {
+  auto options = PipelineOptionsFromParams(v1::PipelineParams());
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(options->ToJson().Dump(), RetrievalPipelineOptions().ToJson().Dump());
+  v1::PipelineParams params;
+  params.set_method(v1::FEATURE_METHOD_RLD);
+  params.set_vocabulary(64);
+  params.set_weighted_frame(false);
+  options = PipelineOptionsFromParams(params);
+  ASSERT_TRUE(options.ok());
+  EXPECT_EQ(options->extractor.method, FeatureMethod::kRldSift);
+  EXPECT_EQ(options->kmeans.num_centroids, 64);
+  EXPECT_FALSE(options->extractor.rld.weighted_frame);
+  EXPECT_EQ(options->extractor.rld.scale_space.scale_factor, 15.0);
+  EXPECT_EQ(options->extractor.ld.scale_space.scale_factor, 20.0);
+  params.set_orientation("sideways");
+  EXPECT_NE(PipelineOptionsFromParams(params).status().message().find("sideways"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace meshseek::rpc

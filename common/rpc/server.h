@@ -1,0 +1,80 @@
+// Server bootstrap shared by every meshseek service, so that each has the
+// same operational behaviour:
+//   - the standard health service (grpc.health.v1) with real serving status:
+//     SERVING once started, NOT_SERVING as soon as shutdown begins (load
+//     balancers stop sending before the port closes);
+//   - reflection, so grpcurl can list and call the services;
+//   - explicit message-size limits (over-limit messages fail with
+//     RESOURCE_EXHAUSTED naming the limit; the server keeps serving);
+//   - a bounded worker pool (the synchronous server's thread cap): excess
+//     calls wait in gRPC's flow control or get RESOURCE_EXHAUSTED, nothing
+//     queues without bound;
+//   - a maximum connection age, so clients re-resolve DNS and find new
+//     replicas;
+//   - graceful shutdown: NOT_SERVING, stop taking calls, let in-flight calls
+//     finish within the grace period, then cancel them.
+#ifndef MESHSEEK_COMMON_RPC_SERVER_H_
+#define MESHSEEK_COMMON_RPC_SERVER_H_
+
+#include <grpcpp/grpcpp.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+
+namespace meshseek::rpc {
+
+struct ServerOptions {
+  /// host:port to listen on; port 0 picks a free port (see RpcServer::port).
+  std::string address = "0.0.0.0:0";
+  /// Largest message received or sent. Meshes of a million triangles and a
+  /// collection's worth of descriptor chunks fit in the default.
+  int max_message_bytes = 64 << 20;
+  /// Threads serving calls (the worker pool bound).
+  int max_threads = 16;
+  /// How long in-flight calls may run on after shutdown begins.
+  absl::Duration grace_period = absl::Seconds(10);
+  /// Connections are closed (gracefully) after this age so that clients
+  /// re-resolve their targets and spread over new replicas.
+  absl::Duration max_connection_age = absl::Seconds(30);
+
+  absl::Status Validate() const;
+};
+
+class RpcServer {
+ public:
+  /// Starts serving `services` (not owned; they must outlive the server).
+  /// `name` is used in log lines. Unavailable when the address cannot be bound.
+  static absl::StatusOr<std::unique_ptr<RpcServer>> Start(const std::string& name,
+                                                          const std::vector<grpc::Service*>& services,
+                                                          const ServerOptions& options);
+  ~RpcServer();
+
+  /// The bound port.
+  int port() const { return port_; }
+  /// Graceful shutdown as described above; idempotent.
+  void Shutdown();
+
+ private:
+  RpcServer() = default;
+  std::string name_;
+  ServerOptions options_;
+  std::unique_ptr<grpc::Server> server_;
+  int port_ = 0;
+  bool shut_down_ = false;
+};
+
+// Blocks SIGTERM and SIGINT in the calling thread and in every thread it
+// starts later; call first thing in main, before any server or thread starts,
+// then WaitForTerminationSignal.
+void BlockTerminationSignals();
+// Waits for SIGTERM or SIGINT and returns its number.
+int WaitForTerminationSignal();
+
+}  // namespace meshseek::rpc
+
+#endif  // MESHSEEK_COMMON_RPC_SERVER_H_

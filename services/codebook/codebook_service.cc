@@ -1,0 +1,156 @@
+#include "services/codebook/codebook_service.h"
+
+#include <filesystem>
+
+#include "absl/strings/str_cat.h"
+#include "common/base/status_macros.h"
+#include "common/features/sift_descriptor.h"
+#include "common/rpc/convert.h"
+#include "common/rpc/status.h"
+
+namespace meshseek {
+
+absl::Status CodebookServiceOptions::Validate() const {
+  if (data_dir.empty()) return absl::InvalidArgumentError("codebook: --data_dir is required");
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::unique_ptr<CodebookService>> CodebookService::Create(
+    const CodebookServiceOptions& options) {
+  MESHSEEK_RETURN_IF_ERROR(options.Validate());
+  std::error_code error;
+  std::filesystem::create_directories(options.data_dir, error);
+  MESHSEEK_ASSIGN_OR_RETURN(std::unique_ptr<Database> db,
+                            Database::Open(options.data_dir + "/codebook.db"));
+  MESHSEEK_RETURN_IF_ERROR(
+      db->Execute("CREATE TABLE IF NOT EXISTS codebooks (id TEXT PRIMARY KEY, "
+                  "training_descriptors INTEGER NOT NULL, data BLOB NOT NULL)"));
+  return std::unique_ptr<CodebookService>(new CodebookService(options, std::move(db)));
+}
+
+void CodebookService::Describe(const std::string& id, const Entry& entry, v1::CodebookInfo* info) {
+  info->set_codebook_id(id);
+  info->set_size(static_cast<uint32_t>(entry.codebook->size()));
+  info->set_dimension(static_cast<uint32_t>(entry.codebook->dim()));
+  info->set_training_descriptors(entry.training_descriptors);
+}
+
+absl::StatusOr<CodebookService::Entry> CodebookService::Find(const std::string& id) {
+  absl::MutexLock lock(&mutex_);
+  if (auto it = cache_.find(id); it != cache_.end()) return it->second;
+  MESHSEEK_ASSIGN_OR_RETURN(
+      Statement select,
+      db_->Prepare("SELECT training_descriptors, data FROM codebooks WHERE id = ?"));
+  select.Bind(1, id);
+  MESHSEEK_ASSIGN_OR_RETURN(const bool found, select.Step());
+  if (!found) return absl::NotFoundError(absl::StrCat("no codebook '", id, "'"));
+  MESHSEEK_ASSIGN_OR_RETURN(Codebook codebook, Codebook::Deserialize(select.ColumnBlob(1)));
+  Entry entry{std::make_shared<const Codebook>(std::move(codebook)),
+              static_cast<uint64_t>(select.ColumnInt(0))};
+  cache_[id] = entry;
+  return entry;
+}
+
+grpc::Status CodebookService::Train(grpc::ServerContext*,
+                                    grpc::ServerReader<v1::TrainCodebookRequest>* reader,
+                                    v1::CodebookInfo* response) {
+  v1::TrainCodebookRequest first;
+  if (!reader->Read(&first)) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "train: empty request stream");
+  }
+  const std::string id = first.codebook_id();
+  if (id.empty()) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "train: codebook_id is empty");
+  }
+  absl::MutexLock training(&train_mutex_);
+  if (absl::StatusOr<Entry> existing = Find(id); existing.ok()) {
+    v1::TrainCodebookRequest rest;
+    while (reader->Read(&rest)) {
+    }
+    Describe(id, *existing, response);
+    return grpc::Status::OK;
+  }
+  const std::size_t dim = first.dimension();
+  if (dim != kSiftDimension) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrCat("train ", id, ": descriptor dimension ", dim, ", expected ",
+                                     kSiftDimension));
+  }
+  std::string descriptors = first.descriptors();
+  v1::TrainCodebookRequest chunk;
+  for (int index = 1; reader->Read(&chunk); ++index) {
+    if (chunk.dimension() != 0 && chunk.dimension() != dim) {
+      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                          absl::StrCat("train ", id, ": chunk ", index, " has dimension ",
+                                       chunk.dimension(), ", the first had ", dim));
+    }
+    descriptors += chunk.descriptors();
+  }
+  if (descriptors.size() % dim != 0) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrCat("train ", id, ": ", descriptors.size(),
+                                     " descriptor bytes are not a multiple of ", dim));
+  }
+  // The same k-means options as the in-process pipeline's
+  // TrainCollectionCodebook: the defaults, then the four that are parameters.
+  KMeansOptions kmeans;
+  if (first.vocabulary() > 0) kmeans.num_centroids = first.vocabulary();
+  if (first.kmeans_points_per_centroid() > 0) {
+    kmeans.max_points_per_centroid = first.kmeans_points_per_centroid();
+  }
+  if (first.kmeans_iterations() > 0) kmeans.max_iterations = first.kmeans_iterations();
+  kmeans.seed = first.seed();
+  kmeans.num_threads = options_.num_threads;
+  const std::size_t count = descriptors.size() / dim;
+  absl::StatusOr<Codebook> codebook = Codebook::Train(
+      reinterpret_cast<const uint8_t*>(descriptors.data()), count, dim, kmeans);
+  if (!codebook.ok()) {
+    return rpc::ToGrpcStatus(absl::Status(
+        codebook.status().code(), absl::StrCat("train ", id, ": ", codebook.status().message())));
+  }
+  Entry entry{std::make_shared<const Codebook>(*std::move(codebook)), count};
+  {
+    absl::MutexLock lock(&mutex_);
+    absl::StatusOr<Statement> insert =
+        db_->Prepare("INSERT OR REPLACE INTO codebooks (id, training_descriptors, data) "
+                     "VALUES (?, ?, ?)");
+    absl::Status stored = insert.ok() ? insert->Bind(1, id)
+                                            .Bind(2, static_cast<int64_t>(count))
+                                            .BindBlob(3, entry.codebook->Serialize())
+                                            .Run()
+                                      : insert.status();
+    if (!stored.ok()) return rpc::ToGrpcStatus(stored);
+    cache_[id] = entry;
+  }
+  Describe(id, entry, response);
+  return grpc::Status::OK;
+}
+
+grpc::Status CodebookService::Encode(grpc::ServerContext*,
+                                     const v1::EncodeRequest* request,
+                                     v1::EncodeResponse* response) {
+  absl::StatusOr<Entry> entry = Find(request->codebook_id());
+  if (!entry.ok()) return rpc::ToGrpcStatus(entry.status());
+  absl::StatusOr<LocalFeatures> features = rpc::FeaturesFromProto(request->features());
+  if (!features.ok()) return rpc::ToGrpcStatus(features.status());
+  std::vector<float> histogram;  // empty: a model without features
+  if (features->size() > 0) {
+    absl::StatusOr<std::vector<float>> encoded =
+        entry->codebook->Encode(features->descriptors.data(), features->size());
+    if (!encoded.ok()) return rpc::ToGrpcStatus(encoded.status());
+    histogram = *std::move(encoded);
+  }
+  rpc::HistogramToProto(histogram, entry->codebook->size(), response->mutable_histogram());
+  return grpc::Status::OK;
+}
+
+grpc::Status CodebookService::GetCodebook(grpc::ServerContext*,
+                                          const v1::GetCodebookRequest* request,
+                                          v1::CodebookInfo* response) {
+  absl::StatusOr<Entry> entry = Find(request->codebook_id());
+  if (!entry.ok()) return rpc::ToGrpcStatus(entry.status());
+  Describe(request->codebook_id(), *entry, response);
+  return grpc::Status::OK;
+}
+
+}  // namespace meshseek

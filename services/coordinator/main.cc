@@ -1,0 +1,51 @@
+// meshseek-coordinator: the API of meshseek (collections, ingest, build,
+// query, evaluation), orchestrating the worker and state services. Flags:
+// --data_dir, the four service targets, the work limits, and the server flags
+// (common/rpc/server_main.h).
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "common/rpc/server_main.h"
+#include "services/coordinator/coordinator_service.h"
+
+namespace {
+const meshseek::CoordinatorOptions kDefaults;
+}
+
+ABSL_FLAG(std::string, data_dir, "", "folder of the coordinator database (required)");
+ABSL_FLAG(std::string, resample, "", "gRPC target of the resample workers, e.g. dns:///resample:50051");
+ABSL_FLAG(std::string, extract, "", "gRPC target of the extract workers, e.g. dns:///extract:50051");
+ABSL_FLAG(std::string, codebook, "", "gRPC target of the codebook service");
+ABSL_FLAG(std::string, index, "", "gRPC target of the index service");
+ABSL_FLAG(int, max_in_flight, kDefaults.max_in_flight,
+          "models extracted at once over all workers (about the workers' total cores)");
+ABSL_FLAG(int, max_pending, kDefaults.max_pending,
+          "ingest acknowledgements wait while this many models wait for extraction");
+ABSL_FLAG(absl::Duration, extract_deadline, kDefaults.extract_deadline,
+          "deadline of one extraction or resampling call");
+ABSL_FLAG(absl::Duration, call_deadline, kDefaults.call_deadline,
+          "deadline of every other call to a service");
+ABSL_FLAG(int, call_attempts, kDefaults.call_attempts,
+          "tries of a call that fails transiently (backoff 0.1 s doubling to 5 s)");
+
+int main(int argc, char** argv) {
+  meshseek::rpc::BlockTerminationSignals();
+  absl::SetProgramUsageMessage("meshseek coordinator: collections, ingest, build, query, eval");
+  absl::ParseCommandLine(argc, argv);
+  meshseek::CoordinatorOptions options;
+  options.data_dir = absl::GetFlag(FLAGS_data_dir);
+  options.resample_target = absl::GetFlag(FLAGS_resample);
+  options.extract_target = absl::GetFlag(FLAGS_extract);
+  options.codebook_target = absl::GetFlag(FLAGS_codebook);
+  options.index_target = absl::GetFlag(FLAGS_index);
+  options.max_in_flight = absl::GetFlag(FLAGS_max_in_flight);
+  options.max_pending = absl::GetFlag(FLAGS_max_pending);
+  options.extract_deadline = absl::GetFlag(FLAGS_extract_deadline);
+  options.call_deadline = absl::GetFlag(FLAGS_call_deadline);
+  options.call_attempts = absl::GetFlag(FLAGS_call_attempts);
+  auto service = meshseek::CoordinatorService::Create(options);
+  if (!service.ok()) return meshseek::rpc::ExitWithError("coordinator", service.status());
+  meshseek::CoordinatorService* coordinator = service->get();
+  return meshseek::rpc::ServeUntilSignal("coordinator", {coordinator},
+                                         [coordinator] { coordinator->Stop(); });
+}

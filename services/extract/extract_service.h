@@ -1,0 +1,40 @@
+// The extract service: mesh (+ resampled graph for RLD-SIFT) -> local
+// features by the requested method (ExtractLocalFeatures). Stateless; the hot
+// path, scaled by replicas.
+//
+// At most `workers` extractions run at once (each is single-threaded and
+// CPU-bound); further calls wait for a slot, and a call whose deadline passes
+// while waiting fails DEADLINE_EXCEEDED without having started.
+#ifndef MESHSEEK_SERVICES_EXTRACT_EXTRACT_SERVICE_H_
+#define MESHSEEK_SERVICES_EXTRACT_EXTRACT_SERVICE_H_
+
+#include "absl/status/status.h"
+#include "absl/synchronization/mutex.h"
+#include "meshseek/v1/extract.grpc.pb.h"
+
+namespace meshseek {
+
+struct ExtractServiceOptions {
+  /// Concurrent extractions; <= 0: one per core.
+  int workers = 0;
+
+  absl::Status Validate() const;
+};
+
+class ExtractService final : public v1::Extract::Service {
+ public:
+  explicit ExtractService(const ExtractServiceOptions& options);
+
+  grpc::Status Extract(grpc::ServerContext* context,
+                       const v1::ExtractRequest* request,
+                       v1::ExtractResponse* response) override;
+
+ private:
+  const int workers_;
+  absl::Mutex mutex_;
+  int busy_ ABSL_GUARDED_BY(mutex_) = 0;
+};
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_SERVICES_EXTRACT_EXTRACT_SERVICE_H_

@@ -1,0 +1,22 @@
+// meshseek-extract: the stateless local-feature worker. Flags: --workers and
+// the server flags (common/rpc/server_main.h).
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "common/rpc/server_main.h"
+#include "services/extract/extract_service.h"
+
+ABSL_FLAG(int, workers, 0, "concurrent extractions (0: one per core)");
+
+int main(int argc, char** argv) {
+  meshseek::rpc::BlockTerminationSignals();
+  absl::SetProgramUsageMessage("meshseek extract worker: mesh -> local features");
+  absl::ParseCommandLine(argc, argv);
+  meshseek::ExtractServiceOptions options;
+  options.workers = absl::GetFlag(FLAGS_workers);
+  if (absl::Status valid = options.Validate(); !valid.ok()) {
+    return meshseek::rpc::ExitWithError("extract", valid);
+  }
+  meshseek::ExtractService service(options);
+  return meshseek::rpc::ServeUntilSignal("extract", {&service});
+}

@@ -1,0 +1,19 @@
+// The resample service: mesh -> N_RLD area-uniform Sobol points joined into a
+// symmetrised kNN graph (ResampleSurfaceGraph, rld_sift.h). Stateless.
+#ifndef MESHSEEK_SERVICES_RESAMPLE_RESAMPLE_SERVICE_H_
+#define MESHSEEK_SERVICES_RESAMPLE_RESAMPLE_SERVICE_H_
+
+#include "meshseek/v1/resample.grpc.pb.h"
+
+namespace meshseek {
+
+class ResampleService final : public v1::Resample::Service {
+ public:
+  grpc::Status Resample(grpc::ServerContext* context,
+                        const v1::ResampleRequest* request,
+                        v1::ResampleResponse* response) override;
+};
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_SERVICES_RESAMPLE_RESAMPLE_SERVICE_H_
