@@ -101,7 +101,7 @@ struct ModelToIngest {
   std::string id;
   std::string label;
   std::string path;
-  std::string where;  // "manifest.csv:12" for error messages
+  std::string where;  // "model 'b' (manifest line 3)", for error messages
 };
 
 absl::StatusOr<std::vector<ModelToIngest>> ModelsFromFlags() {
@@ -111,7 +111,8 @@ absl::StatusOr<std::vector<ModelToIngest>> ModelsFromFlags() {
   if (!manifest.empty()) {
     MESHSEEK_ASSIGN_OR_RETURN(const std::vector<ManifestEntry> entries, ReadManifest(manifest));
     for (const ManifestEntry& e : entries) {
-      models.push_back({e.id, e.label, e.path, absl::StrCat(manifest, ":", e.line)});
+      models.push_back({e.id, e.label, e.path,
+                        absl::StrCat("model '", e.id, "' (manifest line ", e.line, ")")});
     }
   } else if (!folder.empty()) {
     std::error_code error;
@@ -123,7 +124,9 @@ absl::StatusOr<std::vector<ModelToIngest>> ModelsFromFlags() {
     }
     if (error) return absl::NotFoundError(absl::StrCat(folder, ": ", error.message()));
     std::sort(files.begin(), files.end());
-    for (const auto& f : files) models.push_back({f.stem().string(), "", f.string(), f.string()});
+    for (const auto& f : files) {
+      models.push_back({f.stem().string(), "", f.string(), absl::StrCat("model '", f.stem().string(), "'")});
+    }
   } else {
     return absl::InvalidArgumentError("ingest needs --manifest FILE or --folder DIR");
   }
@@ -207,7 +210,8 @@ absl::Status IngestModels(v1::Coordinator::Stub* stub, const std::string& collec
       if (!mesh.ok()) {
         stream->WritesDone();
         reader.join();
-        return absl::Status(mesh.status().code(), absl::StrCat(m.where, ": model ", m.id, ": ", mesh.status().message()));
+        return absl::Status(mesh.status().code(),
+                            absl::StrCat(m.where, ": ", mesh.status().message()));
       }
       v1::IngestRequest request;
       request.set_collection(collection);
@@ -357,7 +361,8 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
   MESHSEEK_RETURN_IF_ERROR(EnsureCollection(stub, collection));
   std::vector<ModelToIngest> to_ingest;
   for (const ManifestEntry& e : models) {
-    to_ingest.push_back({e.id, e.label, e.path, absl::StrCat(manifest_path, ":", e.line)});
+    to_ingest.push_back(
+        {e.id, e.label, e.path, absl::StrCat("model '", e.id, "' (manifest line ", e.line, ")")});
   }
   MESHSEEK_RETURN_IF_ERROR(IngestModels(stub, collection, to_ingest));
   CollectionEvaluation evaluation;

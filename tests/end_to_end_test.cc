@@ -44,7 +44,9 @@ std::string* EndToEndTest::dir_ = nullptr;
 
 // Runs a shell command, returning its exit code and combined output.
 int RunCommand(const std::string& command, std::string* output) {
-  const std::string full = command + " 2>&1";
+  // In the suite's temporary folder: the CLI's embedded stack keeps its state
+  // in ./meshseek-data.
+  const std::string full = "cd " + ::testing::TempDir() + " && " + command + " 2>&1";
   FILE* pipe = popen(full.c_str(), "r");
   if (pipe == nullptr) return -1;
   char buffer[4096];
