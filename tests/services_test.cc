@@ -1,0 +1,471 @@
+// Integration and fault tests of the real server binaries on loopback ports:
+// the services path gives exactly the in-process distance matrix; a kill -9
+// of an extract worker, of the index and of the coordinator loses no
+// acknowledged model; bad input gets the right status code and a message
+// naming the problem, and the servers keep serving.
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <netinet/in.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "common/eval/manifest.h"
+#include "common/geometry/mesh_io.h"
+#include "common/pipeline/retrieval_pipeline.h"
+#include "common/rpc/client.h"
+#include "common/rpc/convert.h"
+#include "common/rpc/status.h"
+#include "common/synth/synthetic_benchmark.h"
+#include "gmock/gmock.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "gtest/gtest.h"
+#include "meshseek/v1/codebook.grpc.pb.h"
+#include "meshseek/v1/coordinator.grpc.pb.h"
+#include "meshseek/v1/extract.grpc.pb.h"
+#include "meshseek/v1/index.grpc.pb.h"
+
+namespace meshseek {
+namespace {
+
+using ::testing::HasSubstr;
+
+int FreePort() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
+  socklen_t len = sizeof addr;
+  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  close(fd);
+  return ntohs(addr.sin_port);
+}
+
+std::string Address(int port) { return absl::StrCat("127.0.0.1:", port); }
+
+// A server binary running as a child process.
+class Server {
+ public:
+  Server(const std::string& role, std::vector<std::string> args, int port) : port_(port) {
+    args_.push_back(std::string(MESHSEEK_SERVICES_DIR) + "/meshseek-" + role);
+    args_.push_back(absl::StrCat("--port=", port));
+    args_.push_back("--grace_period=1s");
+    for (auto& a : args) args_.push_back(std::move(a));
+    log_ = ::testing::TempDir() + "/" + role + "-" + std::to_string(port) + ".log";
+    Start();
+  }
+  ~Server() { Kill(SIGKILL); }
+
+  void Start() {
+    pid_ = fork();
+    if (pid_ == 0) {
+      const int fd = ::open(log_.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+      dup2(fd, 1);
+      dup2(fd, 2);
+      std::vector<char*> argv;
+      for (auto& a : args_) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(argv[0], argv.data());
+      _exit(127);
+    }
+  }
+  void Kill(int signal) {
+    if (pid_ <= 0) return;
+    ::kill(pid_, signal);
+    waitpid(pid_, nullptr, 0);
+    pid_ = -1;
+  }
+  // Waits until the health service says SERVING.
+  bool WaitServing() const {
+    auto stub = grpc::health::v1::Health::NewStub(
+        grpc::CreateChannel(Address(port_), grpc::InsecureChannelCredentials()));
+    for (int i = 0; i < 200; ++i) {
+      grpc::ClientContext context;
+      rpc::SetDeadline(&context, absl::Milliseconds(500));
+      grpc::health::v1::HealthCheckRequest request;
+      grpc::health::v1::HealthCheckResponse response;
+      if (stub->Check(&context, request, &response).ok() &&
+          response.status() == grpc::health::v1::HealthCheckResponse::SERVING) {
+        return true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return false;
+  }
+  int port() const { return port_; }
+
+ private:
+  std::vector<std::string> args_;
+  std::string log_;
+  int port_;
+  pid_t pid_ = -1;
+};
+
+// The whole stack: resample, `extract_workers` extract workers, codebook,
+// index and coordinator, state under `dir`.
+class Stack {
+ public:
+  Stack(const std::string& dir, int extract_workers, int max_pending = 512) : dir_(dir) {
+    resample_ = std::make_unique<Server>("resample", std::vector<std::string>{}, FreePort());
+    std::string targets;
+    for (int w = 0; w < extract_workers; ++w) {
+      extract_.push_back(std::make_unique<Server>(
+          "extract", std::vector<std::string>{"--workers=1"}, FreePort()));
+      absl::StrAppend(&targets, targets.empty() ? "" : ",", Address(extract_.back()->port()));
+    }
+    codebook_ = std::make_unique<Server>(
+        "codebook", std::vector<std::string>{"--data_dir=" + dir + "/codebook"}, FreePort());
+    index_ = std::make_unique<Server>(
+        "index", std::vector<std::string>{"--data_dir=" + dir + "/index"}, FreePort());
+    coordinator_args_ = {"--data_dir=" + dir + "/coordinator",
+                         "--resample=" + Address(resample_->port()),
+                         "--extract=ipv4:" + targets,
+                         "--codebook=" + Address(codebook_->port()),
+                         "--index=" + Address(index_->port()),
+                         absl::StrCat("--max_in_flight=", extract_workers),
+                         absl::StrCat("--max_pending=", max_pending)};
+    coordinator_ = std::make_unique<Server>("coordinator", coordinator_args_, FreePort());
+  }
+  bool WaitServing() {
+    for (Server* s : {resample_.get(), codebook_.get(), index_.get(), coordinator_.get()}) {
+      if (!s->WaitServing()) return false;
+    }
+    for (auto& e : extract_) {
+      if (!e->WaitServing()) return false;
+    }
+    return true;
+  }
+  std::unique_ptr<v1::Coordinator::Stub> Coordinator() const {
+    return v1::Coordinator::NewStub(rpc::MakeChannel(Address(coordinator_->port())));
+  }
+  Server& coordinator() { return *coordinator_; }
+  Server& index() { return *index_; }
+  Server& extract(int i) { return *extract_[i]; }
+  Server& codebook() { return *codebook_; }
+
+ private:
+  std::string dir_;
+  std::unique_ptr<Server> resample_, codebook_, index_, coordinator_;
+  std::vector<std::unique_ptr<Server>> extract_;
+  std::vector<std::string> coordinator_args_;
+};
+
+// Small parameters: the test is about the system, not accuracy.
+v1::PipelineParams TestParams() {
+  v1::PipelineParams params;
+  params.set_method(v1::FEATURE_METHOD_DLD);
+  params.set_num_points(96);
+  params.set_vocabulary(24);
+  return params;
+}
+
+class ServicesTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(::testing::TempDir() + "/meshseek_services");
+    std::filesystem::remove_all(*dir_);
+    ASSERT_TRUE(GenerateSyntheticBenchmark(SyntheticBenchmarkOptions(), *dir_ + "/bench").ok());
+    auto models = ReadManifest(*dir_ + "/bench/manifest.csv");
+    ASSERT_TRUE(models.ok());
+    models_ = new std::vector<ManifestEntry>(*models);
+    auto options = rpc::PipelineOptionsFromParams(TestParams());
+    ASSERT_TRUE(options.ok());
+    auto reference = EvaluateCollection(*models_, *options);
+    ASSERT_TRUE(reference.ok()) << reference.status();
+    reference_ = new std::vector<float>(reference->distances);
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    delete models_;
+    delete reference_;
+  }
+
+  static absl::Status CreateCollection(v1::Coordinator::Stub* stub, const std::string& name) {
+    grpc::ClientContext context;
+    rpc::SetDeadline(&context, absl::Seconds(10));
+    v1::CreateCollectionRequest request;
+    request.set_name(name);
+    *request.mutable_params() = TestParams();
+    v1::Collection response;
+    return rpc::FromGrpcStatus(stub->CreateCollection(&context, request, &response));
+  }
+
+  // Streams models [begin, end) and returns how many were acknowledged;
+  // `after_ack(n)` runs after the n-th acknowledgement.
+  static std::size_t Ingest(v1::Coordinator::Stub* stub, const std::string& collection,
+                            std::size_t begin, std::size_t end, std::set<std::string>* jobs,
+                            const std::function<void(std::size_t)>& after_ack = nullptr) {
+    grpc::ClientContext context;
+    rpc::SetDeadline(&context, absl::Minutes(3));
+    context.set_wait_for_ready(true);  // the coordinator may just have restarted
+    auto stream = stub->Ingest(&context);
+    std::size_t acked = 0;
+    std::thread reader([&] {
+      v1::IngestAck ack;
+      while (stream->Read(&ack)) {
+        jobs->insert(ack.job_id());
+        ++acked;
+        if (after_ack) after_ack(acked);
+      }
+    });
+    for (std::size_t i = begin; i < end; ++i) {
+      const ManifestEntry& m = (*models_)[i];
+      v1::IngestRequest request;
+      request.set_collection(collection);
+      request.set_model_id(m.id);
+      request.set_label(m.label);
+      auto mesh = ReadMesh(m.path);
+      rpc::MeshToProto(*mesh, request.mutable_mesh()->mutable_mesh());
+      if (!stream->Write(request)) break;
+    }
+    stream->WritesDone();
+    reader.join();
+    stream->Finish();
+    return acked;
+  }
+
+  // Polls a job until it ends (the coordinator may be restarting meanwhile).
+  static v1::JobStatus WaitJob(v1::Coordinator::Stub* stub, const std::string& job_id) {
+    v1::JobStatus status;
+    for (int i = 0; i < 1200; ++i) {
+      grpc::ClientContext context;
+      rpc::SetDeadline(&context, absl::Seconds(2));
+      v1::JobRequest request;
+      request.set_job_id(job_id);
+      if (stub->GetJob(&context, request, &status).ok() &&
+          status.state() != v1::JOB_STATE_RUNNING) {
+        return status;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return status;
+  }
+
+  static std::string Build(v1::Coordinator::Stub* stub, const std::string& collection) {
+    grpc::ClientContext context;
+    rpc::SetDeadline(&context, absl::Seconds(10));
+    context.set_wait_for_ready(true);
+    v1::BuildRequest request;
+    request.set_collection(collection);
+    v1::JobStatus job;
+    const grpc::Status status = stub->Build(&context, request, &job);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return job.job_id();
+  }
+
+  // The collection's matrix, reordered to manifest order.
+  static std::vector<float> Evaluate(v1::Coordinator::Stub* stub, const std::string& collection) {
+    grpc::ClientContext context;
+    rpc::SetDeadline(&context, absl::Minutes(1));
+    context.set_wait_for_ready(true);
+    v1::EvaluateRequest request;
+    request.set_collection(collection);
+    auto reader = stub->Evaluate(&context, request);
+    const std::size_t n = models_->size();
+    std::map<std::string, std::size_t> position;
+    for (std::size_t i = 0; i < n; ++i) position[(*models_)[i].id] = i;
+    std::vector<v1::EvaluateRow> rows;
+    v1::EvaluateRow row;
+    while (reader->Read(&row)) rows.push_back(row);
+    const grpc::Status status = reader->Finish();
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    if (rows.size() != n) return {};
+    std::vector<float> matrix(n * n);
+    for (const auto& r : rows) {
+      for (std::size_t c = 0; c < n; ++c) {
+        matrix[position[r.model_id()] * n + position[rows[c].model_id()]] = r.distances(c);
+      }
+    }
+    return matrix;
+  }
+
+  static std::string* dir_;
+  static std::vector<ManifestEntry>* models_;
+  static std::vector<float>* reference_;
+};
+std::string* ServicesTest::dir_ = nullptr;
+std::vector<ManifestEntry>* ServicesTest::models_ = nullptr;
+std::vector<float>* ServicesTest::reference_ = nullptr;
+
+TEST_F(ServicesTest, KilledExtractWorkerLosesNothingAndResultEqualsInProcess) {
+  Stack stack(*dir_ + "/kill-extract", 2, /*max_pending=*/8);
+  ASSERT_TRUE(stack.WaitServing());
+  auto stub = stack.Coordinator();
+  ASSERT_TRUE(CreateCollection(stub.get(), "synthetic").ok());
+  std::set<std::string> jobs;
+  const std::size_t n = models_->size();
+  const std::size_t acked = Ingest(stub.get(), "synthetic", 0, n, &jobs, [&](std::size_t a) {
+    if (a == 12) stack.extract(0).Kill(SIGKILL);  // mid-ingest, work in flight
+  });
+  ASSERT_EQ(acked, n);
+  ASSERT_EQ(jobs.size(), 1u);
+  const v1::JobStatus ingest = WaitJob(stub.get(), *jobs.begin());
+  EXPECT_EQ(ingest.state(), v1::JOB_STATE_SUCCEEDED) << ingest.DebugString();
+  EXPECT_EQ(ingest.done(), n);
+  const v1::JobStatus build = WaitJob(stub.get(), Build(stub.get(), "synthetic"));
+  ASSERT_EQ(build.state(), v1::JOB_STATE_SUCCEEDED) << build.DebugString();
+
+  // Every model indexed exactly once.
+  auto index = v1::Index::NewStub(rpc::MakeChannel(Address(stack.index().port())));
+  grpc::ClientContext context;
+  v1::ListModelsRequest list;
+  list.set_collection("synthetic");
+  v1::ListModelsResponse listed;
+  ASSERT_TRUE(index->ListModels(&context, list, &listed).ok());
+  std::set<std::string> ids(listed.model_ids().begin(), listed.model_ids().end());
+  EXPECT_EQ(listed.model_ids_size(), static_cast<int>(n));
+  EXPECT_EQ(ids.size(), n);
+
+  // Bit for bit the in-process pipeline's matrix.
+  EXPECT_EQ(Evaluate(stub.get(), "synthetic"), *reference_);
+}
+
+TEST_F(ServicesTest, KilledAndRestartedIndexAndCoordinatorLoseNoAcknowledgedModel) {
+  Stack stack(*dir_ + "/kill-state", 1);
+  ASSERT_TRUE(stack.WaitServing());
+  auto stub = stack.Coordinator();
+  ASSERT_TRUE(CreateCollection(stub.get(), "synthetic").ok());
+  const std::size_t n = models_->size();
+  std::set<std::string> jobs;
+  // Half the models, then the coordinator dies right after acknowledging.
+  ASSERT_EQ(Ingest(stub.get(), "synthetic", 0, n / 2, &jobs), n / 2);
+  stack.coordinator().Kill(SIGKILL);
+  stack.coordinator().Start();
+  ASSERT_TRUE(stack.coordinator().WaitServing());
+  // The client re-sends everything (idempotent by id) and adds the rest.
+  std::set<std::string> jobs2;
+  ASSERT_EQ(Ingest(stub.get(), "synthetic", 0, n, &jobs2), n);
+  for (const std::string& job : jobs2) {
+    const v1::JobStatus status = WaitJob(stub.get(), job);
+    EXPECT_EQ(status.state(), v1::JOB_STATE_SUCCEEDED) << status.DebugString();
+  }
+  EXPECT_TRUE(jobs2.count(*jobs.begin())) << "re-sent models keep their first job";
+  // Build while the index is down: its adds fail, are retried, and land once
+  // the index is back.
+  stack.index().Kill(SIGKILL);
+  const std::string build_id = Build(stub.get(), "synthetic");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  stack.index().Start();
+  ASSERT_TRUE(stack.index().WaitServing());
+  const v1::JobStatus build = WaitJob(stub.get(), build_id);
+  ASSERT_EQ(build.state(), v1::JOB_STATE_SUCCEEDED) << build.DebugString();
+  EXPECT_EQ(Evaluate(stub.get(), "synthetic"), *reference_);
+
+  // Restart both again: the index is restored from its database.
+  stack.index().Kill(SIGKILL);
+  stack.coordinator().Kill(SIGKILL);
+  stack.index().Start();
+  stack.coordinator().Start();
+  ASSERT_TRUE(stack.index().WaitServing());
+  ASSERT_TRUE(stack.coordinator().WaitServing());
+  EXPECT_EQ(Evaluate(stub.get(), "synthetic"), *reference_);
+}
+
+TEST_F(ServicesTest, BadInputGetsTheRightCodeANamedProblemAndServersKeepServing) {
+  Stack stack(*dir_ + "/bad-input", 1);
+  ASSERT_TRUE(stack.WaitServing());
+  auto stub = stack.Coordinator();
+  ASSERT_TRUE(CreateCollection(stub.get(), "good").ok());
+
+  // Unknown collection.
+  {
+    grpc::ClientContext context;
+    v1::GetCollectionRequest request;
+    request.set_name("nope");
+    v1::Collection response;
+    const grpc::Status status = stub->GetCollection(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+    EXPECT_THAT(status.error_message(), HasSubstr("nope"));
+  }
+  // Malformed mesh in an ingest stream: the stream ends naming the model.
+  {
+    grpc::ClientContext context;
+    auto stream = stub->Ingest(&context);
+    v1::IngestRequest request;
+    request.set_collection("good");
+    request.set_model_id("broken-17");
+    v1::Mesh* mesh = request.mutable_mesh()->mutable_mesh();
+    for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) mesh->add_vertices(v);
+    for (uint32_t t : {0u, 1u, 9u}) mesh->add_triangles(t);
+    stream->Write(request);
+    stream->WritesDone();
+    v1::IngestAck ack;
+    EXPECT_FALSE(stream->Read(&ack));
+    const grpc::Status status = stream->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("broken-17"));
+    EXPECT_THAT(status.error_message(), HasSubstr("9"));
+  }
+  // Wrong descriptor size at the codebook (after a real build).
+  {
+    std::set<std::string> jobs;
+    ASSERT_EQ(Ingest(stub.get(), "good", 0, 8, &jobs), 8u);
+    WaitJob(stub.get(), *jobs.begin());
+    const v1::JobStatus build = WaitJob(stub.get(), Build(stub.get(), "good"));
+    ASSERT_EQ(build.state(), v1::JOB_STATE_SUCCEEDED) << build.DebugString();
+    auto codebook = v1::Codebook::NewStub(rpc::MakeChannel(Address(stack.codebook().port())));
+    grpc::ClientContext context;
+    v1::EncodeRequest request;
+    request.set_codebook_id("good@" + build.job_id());
+    request.mutable_features()->set_count(2);
+    request.mutable_features()->set_dimension(128);
+    request.mutable_features()->set_descriptors(std::string(200, '\1'));
+    v1::EncodeResponse response;
+    const grpc::Status status = codebook->Encode(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("200 descriptor bytes"));
+  }
+  // An over-limit message to an extract worker.
+  {
+    auto extract = v1::Extract::NewStub(
+        grpc::CreateChannel(Address(stack.extract(0).port()), grpc::InsecureChannelCredentials()));
+    grpc::ClientContext context;
+    v1::ExtractRequest request;
+    request.mutable_mesh()->mutable_file()->set_name("huge.off");
+    request.mutable_mesh()->mutable_file()->set_data(std::string(65 << 20, ' '));
+    v1::ExtractResponse response;
+    const grpc::Status status = extract->Extract(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+  }
+  // Every server still serves, and a query works.
+  EXPECT_TRUE(stack.WaitServing());
+  // Discovery through reflection (what grpcurl list shows), and the probe.
+  {
+    const std::string command = std::string(MESHSEEK_SERVICES_DIR) + "/meshseek-probe --addr " +
+                                Address(stack.coordinator().port());
+    std::string listed;
+    FILE* pipe = popen((command + " --list").c_str(), "r");
+    char buffer[512];
+    while (fgets(buffer, sizeof buffer, pipe) != nullptr) listed += buffer;
+    EXPECT_EQ(pclose(pipe), 0);
+    EXPECT_THAT(listed, HasSubstr("meshseek.v1.Coordinator"));
+    EXPECT_THAT(listed, HasSubstr("grpc.health.v1.Health"));
+    EXPECT_EQ(std::system((command + " > /dev/null").c_str()), 0);
+  }
+  {
+    grpc::ClientContext context;
+    v1::QueryRequest request;
+    request.set_collection("good");
+    request.set_top_k(3);
+    rpc::MeshToProto(*ReadMesh((*models_)[0].path), request.mutable_mesh()->mutable_mesh());
+    v1::QueryResponse response;
+    const grpc::Status status = stub->Query(&context, request, &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    ASSERT_EQ(response.results_size(), 3);
+    EXPECT_EQ(response.results(0).model_id(), (*models_)[0].id);
+    EXPECT_EQ(response.results(0).distance(), 0.0f);
+  }
+}
+
+}  // namespace
+}  // namespace meshseek
