@@ -3,8 +3,9 @@
 #   1. per-model extraction time of every method on one core (median and p90
 #      over the first 50 McGill articulated models, ~13k vertices each), and
 #      RLD-SIFT's time against N_RLD;
-#   2. the whole `meshseek eval` of McGill articulated on all cores: wall time
-#      and peak memory.
+#   2. the whole `meshseek eval` of McGill articulated on all cores, through
+#      the embedded services with a fresh data folder: wall time and peak
+#      memory.
 # Results go to bench/results/speed_*.{json,txt}.
 #
 #   bench/speed.sh [DATA_DIR]    (default: ~/.cache/meshseek-data)
@@ -31,8 +32,9 @@ PY
 cat "$OUT/speed_extract.txt"
 {
   echo "machine: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores"
-  echo "command: build/cli/meshseek eval --manifest $DATA/msb_articulated/manifest.csv --method dld --out out/msb"
+  echo "command: build/cli/meshseek eval --manifest $DATA/msb_articulated/manifest.csv --method dld --out out/msb --data_dir <fresh>"
+  rm -rf out/speed-data
   /usr/bin/time -f "wall %e s, user %U s, peak RSS %M KiB" \
     build/cli/meshseek eval --manifest "$DATA/msb_articulated/manifest.csv" --method dld --out out/msb \
-    --progress=false 2>&1
+    --data_dir out/speed-data --progress=false 2>&1 | grep -v "^I "
 } | tee "$OUT/speed_eval_msb.txt"

@@ -7,4 +7,6 @@ cd "$(dirname "$0")/.."
 ./scripts/build.sh
 BIN=${MESHSEEK_BUILD_DIR:-build}/cli/meshseek
 "$BIN" synth --out out/synthetic
-"$BIN" eval --manifest out/synthetic/manifest.csv --method dld --out out/synthetic-eval
+# Through the embedded stack: every service on loopback ports, state in out/meshseek-data.
+"$BIN" eval --manifest out/synthetic/manifest.csv --method dld --out out/synthetic-eval \
+  --data_dir out/meshseek-data
