@@ -35,6 +35,9 @@ class EndToEndTest : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new std::string(::testing::TempDir() + "/meshseek_e2e");
     std::filesystem::remove_all(*dir_);
+    // The CLI's embedded stack keeps collections (and their features) here:
+    // start clean so that no run reuses features of an older build.
+    std::filesystem::remove_all(::testing::TempDir() + "/meshseek-data");
     ASSERT_TRUE(GenerateSyntheticBenchmark(SyntheticBenchmarkOptions(), *dir_ + "/bench").ok());
   }
   static void TearDownTestSuite() { delete dir_; }
