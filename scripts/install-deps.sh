@@ -4,16 +4,23 @@
 # when not run as root.
 set -euo pipefail
 
+# Packages that build the services and the CLI (the container image needs only
+# these: install-deps.sh --build-only), then those of tests and benchmarks.
 PACKAGES=(
-  g++ cmake ninja-build pkg-config ccache python3   # toolchain; python3 runs the reference evaluator
+  g++ cmake ninja-build pkg-config                   # toolchain
   libabsl-dev                                        # Status, flags, strings
   libopenmesh-dev                                    # mesh file readers
   libopencv-dev                                      # SIFT descriptor (features2d)
   libflann-dev liblz4-dev                            # k-nearest-neighbour graph (RLD-SIFT)
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # services
   libsqlite3-dev                                     # state of the stateful services
-  libgtest-dev libgmock-dev libbenchmark-dev         # tests and benchmarks
 )
+if [ "${1:-}" != "--build-only" ]; then
+  PACKAGES+=(
+    ccache python3                                   # faster rebuilds; python3 runs the reference evaluator
+    libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
+  )
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -26,6 +26,9 @@ std::shared_ptr<grpc::Channel> MakeChannel(const std::string& target,
   args.SetServiceConfigJSON(config);
   args.SetMaxReceiveMessageSize(options.max_message_bytes);
   args.SetMaxSendMessageSize(options.max_message_bytes);
+  // Re-resolve DNS names at most every 5 s (gRPC's default is 30 s), so a
+  // scaled-up worker set is seen soon after connections recycle.
+  args.SetInt(GRPC_ARG_DNS_MIN_TIME_BETWEEN_RESOLUTIONS_MS, 5000);
   // Reconnect quickly to a replica that comes back.
   args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
   args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 2000);

@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# End-to-end test of the compose deployment on this Docker host (not run by CI:
+# building the image takes about ten minutes; run it before changing deploy/):
+#   1. builds the base image (no registry: deploy/make-base-image.sh) and the
+#      meshseek image from deploy/Dockerfile;
+#   2. brings the compose stack up with one extract replica and runs
+#      `meshseek eval` on the synthetic benchmark through the published
+#      coordinator, scaling extract to 3 during the ingest and killing one
+#      extract container hard in the middle;
+#   3. checks every model is indexed exactly once and the distance matrix and
+#      metrics equal an embedded run's;
+#   4. brings the stack down and up again and checks the index is still there.
+# Needs a Release build in ./build (scripts/build.sh) for the CLI.
+#   tests/deploy_test.sh [--keep]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+BIN=$ROOT/build/cli/meshseek
+PROBE=$ROOT/build/services/meshseek-probe
+COMPOSE="docker-compose -p meshseek-test -f deploy/docker-compose.yml"
+export MESHSEEK_IMAGE=meshseek:test
+export MESHSEEK_PORT=${MESHSEEK_PORT:-50551}
+T=$(mktemp -d)
+cleanup() {
+  if [ "${1:-}" != "--keep" ]; then $COMPOSE down -v --remove-orphans >/dev/null 2>&1 || true; fi
+  rm -rf "$T"
+}
+trap 'cleanup "${KEEP:-}"' EXIT
+[ "${1:-}" = "--keep" ] && KEEP=--keep
+step() { echo "deploy_test: $*"; }
+fail() { echo "deploy_test: FAILED: $*" >&2; exit 1; }
+
+step "image"
+deploy/make-base-image.sh
+docker build -q -f deploy/Dockerfile --build-arg BASE=meshseek-base:bookworm -t "$MESHSEEK_IMAGE" . >/dev/null
+docker image ls "$MESHSEEK_IMAGE" --format 'deploy_test: image {{.Repository}}:{{.Tag}} {{.Size}}'
+[ "$(docker run --rm "$MESHSEEK_IMAGE" id -un)" = meshseek ] || fail "image does not run as meshseek"
+
+step "reference: the synthetic benchmark through the embedded stack"
+"$BIN" synth --out "$T/syn" >/dev/null
+"$BIN" eval --progress=false --manifest "$T/syn/manifest.csv" --out "$T/embedded" \
+  --data_dir "$T/embedded-data" 2>/dev/null | grep -E "micro|macro"
+
+wait_serving() {
+  for _ in $(seq 150); do "$PROBE" --addr "localhost:$MESHSEEK_PORT" >/dev/null 2>&1 && return 0; sleep 0.2; done
+  fail "coordinator not serving on port $MESHSEEK_PORT"
+}
+
+step "compose up with 1 extract replica"
+$COMPOSE down -v --remove-orphans >/dev/null 2>&1 || true
+$COMPOSE up -d --scale extract=1 2>&1 | grep -v "^Creating\|^Starting" || true
+wait_serving
+
+step "eval through the published coordinator; scale extract 1 -> 3 and kill one mid-ingest"
+"$BIN" eval --progress=false --server "localhost:$MESHSEEK_PORT" --collection synthetic \
+  --manifest "$T/syn/manifest.csv" --out "$T/cluster" > "$T/cluster.log" 2>&1 &
+EVAL=$!
+sleep 3
+$COMPOSE up -d --no-recreate --scale extract=3 2>&1 | grep -v "^Creating\|^Starting" || true
+sleep 4
+victim=$($COMPOSE ps -q extract | head -1)
+docker kill --signal KILL "$victim" >/dev/null
+step "killed extract container ${victim:0:12}"
+wait "$EVAL" || { cat "$T/cluster.log"; fail "eval through the cluster failed"; }
+grep -E "micro|macro" "$T/cluster.log"
+
+step "checks"
+cmp "$T/embedded/distances.bin" "$T/cluster/distances.bin" || fail "distance matrices differ"
+python3 - "$T/embedded/metrics.json" "$T/cluster/metrics.json" <<'PY' || fail "metrics differ"
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:])
+keys = ["queries", "classes", "micro", "macro", "per_class", "local_features"]
+sys.exit(0 if all(a[k] == b[k] for k in keys) else 1)
+PY
+status=$("$BIN" status --server "localhost:$MESHSEEK_PORT" --collection synthetic)
+echo "$status" | head -1
+echo "$status" | grep -q "72 models, 72 extracted, 72 indexed" || fail "not every model indexed once: $status"
+[ "$($COMPOSE ps -q extract | wc -l)" -eq 3 ] || fail "expected 3 extract containers"
+
+step "down and up again: the index is still there"
+$COMPOSE down 2>&1 | grep -v "^Stopping\|^Removing" || true
+$COMPOSE up -d 2>&1 | grep -v "^Creating\|^Starting" || true
+wait_serving
+"$BIN" status --server "localhost:$MESHSEEK_PORT" --collection synthetic | grep -q "72 indexed" \
+  || fail "index lost after down/up"
+"$BIN" eval --progress=false --server "localhost:$MESHSEEK_PORT" --collection synthetic \
+  --manifest "$T/syn/manifest.csv" --out "$T/again" >/dev/null 2>&1 || fail "eval after restart"
+cmp "$T/embedded/distances.bin" "$T/again/distances.bin" || fail "matrix changed after restart"
+step "PASSED"
