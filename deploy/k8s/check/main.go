@@ -1,0 +1,158 @@
+// Command check validates meshseek's Kubernetes manifests offline, without a
+// cluster: every document is decoded strictly (unknown or mistyped fields are
+// errors) into the Kubernetes API's own Go types (k8s.io/api), and every
+// image, port, binary and flag the manifests name is checked against the
+// built meshseek binaries.
+//
+//	go run ./deploy/k8s/check -bin build/services deploy/k8s/*.yaml
+package main
+
+import (
+	"bytes"
+	"flag"
+	"fmt"
+	"os"
+	"os/exec"
+	"path/filepath"
+	"strings"
+
+	appsv1 "k8s.io/api/apps/v1"
+	autoscalingv2 "k8s.io/api/autoscaling/v2"
+	corev1 "k8s.io/api/core/v1"
+	"sigs.k8s.io/yaml"
+)
+
+var (
+	binDir = flag.String("bin", "build/services", "folder of the built meshseek-* binaries")
+	image  = flag.String("image", "meshseek:latest", "the image every container must run")
+)
+
+type problems []string
+
+func (p *problems) add(format string, args ...any) { *p = append(*p, fmt.Sprintf(format, args...)) }
+
+// flagsOf returns the flags a binary accepts, from its --helpfull.
+func flagsOf(binary string, cache map[string]string) (string, error) {
+	if help, ok := cache[binary]; ok {
+		return help, nil
+	}
+	out, _ := exec.Command(filepath.Join(*binDir, binary), "--helpfull").CombinedOutput()
+	if !bytes.Contains(out, []byte("Flags from")) {
+		return "", fmt.Errorf("%s: no such binary in %s", binary, *binDir)
+	}
+	cache[binary] = string(out)
+	return string(out), nil
+}
+
+func checkPod(where string, spec corev1.PodSpec, p *problems, help map[string]string) {
+	for _, c := range spec.Containers {
+		if c.Image != *image {
+			p.add("%s: container %s runs image %q, want %q", where, c.Name, c.Image, *image)
+		}
+		if len(c.Args) == 0 {
+			p.add("%s: container %s has no args (the role is the command)", where, c.Name)
+			continue
+		}
+		flags, err := flagsOf(c.Args[0], help)
+		if err != nil {
+			p.add("%s: %v", where, err)
+			continue
+		}
+		port := ""
+		for _, a := range c.Args[1:] {
+			name, value, _ := strings.Cut(strings.TrimPrefix(a, "--"), "=")
+			if !strings.Contains(flags, "-"+name+" ") && !strings.Contains(flags, "-"+name+")") {
+				p.add("%s: %s has no flag --%s", where, c.Args[0], name)
+			}
+			if name == "port" {
+				port = value
+			}
+		}
+		ports := map[string]int32{}
+		for _, cp := range c.Ports {
+			ports[cp.Name] = cp.ContainerPort
+			if fmt.Sprint(cp.ContainerPort) != port {
+				p.add("%s: containerPort %d but the server listens on --port=%s", where, cp.ContainerPort, port)
+			}
+		}
+		for _, probe := range []*corev1.Probe{c.ReadinessProbe, c.LivenessProbe} {
+			if probe == nil || probe.GRPC == nil {
+				p.add("%s: container %s needs gRPC readiness and liveness probes", where, c.Name)
+			} else if fmt.Sprint(probe.GRPC.Port) != port {
+				p.add("%s: probe on port %d, server on %s", where, probe.GRPC.Port, port)
+			}
+		}
+		if c.Resources.Requests.Cpu().IsZero() || c.Resources.Limits.Memory().IsZero() {
+			p.add("%s: container %s needs resource requests and limits", where, c.Name)
+		}
+	}
+	if spec.TerminationGracePeriodSeconds == nil || *spec.TerminationGracePeriodSeconds < 11 {
+		p.add("%s: terminationGracePeriodSeconds must exceed the servers' 10 s drain", where)
+	}
+}
+
+func main() {
+	flag.Parse()
+	var p problems
+	help := map[string]string{}
+	for _, file := range flag.Args() {
+		data, err := os.ReadFile(file)
+		if err != nil {
+			p.add("%v", err)
+			continue
+		}
+		for i, doc := range bytes.Split(data, []byte("\n---\n")) {
+			var meta struct{ Kind string }
+			if err := yaml.Unmarshal(doc, &meta); err != nil {
+				p.add("%s document %d: %v", file, i+1, err)
+				continue
+			}
+			where := fmt.Sprintf("%s document %d (%s)", file, i+1, meta.Kind)
+			var obj any
+			switch meta.Kind {
+			case "Namespace":
+				obj = &corev1.Namespace{}
+			case "Service":
+				obj = &corev1.Service{}
+			case "Deployment":
+				obj = &appsv1.Deployment{}
+			case "StatefulSet":
+				obj = &appsv1.StatefulSet{}
+			case "HorizontalPodAutoscaler":
+				obj = &autoscalingv2.HorizontalPodAutoscaler{}
+			case "Kustomization":
+				continue
+			default:
+				p.add("%s: unexpected kind", where)
+				continue
+			}
+			if err := yaml.UnmarshalStrict(doc, obj); err != nil {
+				p.add("%s: %v", where, err)
+				continue
+			}
+			switch o := obj.(type) {
+			case *appsv1.Deployment:
+				checkPod(where, o.Spec.Template.Spec, &p, help)
+			case *appsv1.StatefulSet:
+				checkPod(where, o.Spec.Template.Spec, &p, help)
+				if len(o.Spec.VolumeClaimTemplates) == 0 {
+					p.add("%s: a stateful role needs a volume claim", where)
+				}
+			case *corev1.Service:
+				for _, sp := range o.Spec.Ports {
+					if sp.TargetPort.String() != "grpc" || sp.Port != 50051 {
+						p.add("%s: port %d -> %s, want 50051 -> grpc", where, sp.Port, sp.TargetPort.String())
+					}
+				}
+			}
+			fmt.Printf("ok  %s\n", where)
+		}
+	}
+	if len(p) > 0 {
+		for _, msg := range p {
+			fmt.Fprintln(os.Stderr, "FAIL", msg)
+		}
+		os.Exit(1)
+	}
+	fmt.Println("all manifests valid")
+}
