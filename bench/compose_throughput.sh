@@ -4,6 +4,7 @@
 # single-node Docker Swarm (--swarm). Uses the image meshseek:test that
 # tests/deploy_test.sh builds, and the CLI in ./build.
 #   bench/compose_throughput.sh [MANIFEST] [--swarm]
+# (COMPOSE_REPLICAS="" skips the compose runs.)
 # Appends to bench/results/deploy.txt.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,7 +24,7 @@ ingest() {  # collection -> seconds
     --collection "$1" --manifest "$MANIFEST" 2>&1 >/dev/null | tail -1
 }
 echo "# bench/compose_throughput.sh $(date -u +%F), $(nproc) cores: $(lscpu | sed -n 's/^Model name: *//p'); $MANIFEST ($n models), DLD-SIFT defaults" >> "$RESULT"
-for r in 1 2 3; do
+for r in ${COMPOSE_REPLICAS-1 2 3}; do
   $COMPOSE down -v >/dev/null 2>&1 || true
   MESHSEEK_MAX_IN_FLIGHT=$r $COMPOSE up -d --scale extract=$r >/dev/null 2>&1
   wait_serving

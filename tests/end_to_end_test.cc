@@ -142,6 +142,9 @@ TEST_F(EndToEndTest, EveryMethodRunsThroughTheCliWithTheSameOutputs) {
     ASSERT_TRUE(json.ok());
     EXPECT_THAT(*json, HasSubstr("\"method\": \"" + method + "\""));
     EXPECT_THAT(*json, HasSubstr("\"models_without_features\""));
+    // The flags' defaults are each method's own measured scale factor (a
+    // shared --scale_factor default once gave LD-SIFT RLD-SIFT's).
+    EXPECT_THAT(*json, HasSubstr(method == "ld" ? "\"scale_factor_C\": 20" : "\"scale_factor_C\": 15"));
   }
 }
 
