@@ -88,13 +88,7 @@ rpc::RetryOptions ReconnectRetry() {
 template <typename Request, typename Response, typename Method>
 absl::Status Call(v1::Coordinator::Stub* stub, Method method, const Request& request,
                   Response* response, absl::Duration deadline = absl::Minutes(1)) {
-  return rpc::RetryTransient(
-      [&] {
-        grpc::ClientContext context;
-        rpc::SetDeadline(&context, deadline);
-        return rpc::FromGrpcStatus((stub->*method)(&context, request, response));
-      },
-      ReconnectRetry());
+  return rpc::CallWithRetry(stub, method, request, response, deadline, ReconnectRetry());
 }
 
 struct ModelToIngest {

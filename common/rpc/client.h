@@ -53,6 +53,31 @@ absl::Status RetryTransient(const std::function<absl::Status()>& call,
                             const RetryOptions& options = {},
                             const std::atomic<bool>* stop = nullptr);
 
+// One unary call as every meshseek client makes it: a fresh context with a
+// deadline `timeout` per try, retried by RetryTransient. `method` is a
+// generated stub's blocking method, e.g. &v1::Extract::Stub::Extract.
+template <typename Stub, typename Request, typename Response>
+absl::Status CallWithRetry(Stub* stub,
+                           grpc::Status (Stub::*method)(grpc::ClientContext*,
+                                                        const Request&,
+                                                        Response*),
+                           const Request& request,
+                           Response* response,
+                           absl::Duration timeout,
+                           const RetryOptions& retry = {},
+                           const std::atomic<bool>* stop = nullptr) {
+  return RetryTransient(
+      [&] {
+        grpc::ClientContext context;
+        SetDeadline(&context, timeout);
+        const grpc::Status status = (stub->*method)(&context, request, response);
+        return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
+                            status.error_message());
+      },
+      retry,
+      stop);
+}
+
 }  // namespace meshseek::rpc
 
 #endif  // MESHSEEK_COMMON_RPC_CLIENT_H_

@@ -76,6 +76,7 @@ absl::Status CoordinatorOptions::Validate() const {
 }
 
 CoordinatorService::CoordinatorService(const CoordinatorOptions& options) : options_(options) {
+  retry_.attempts = options.call_attempts;
   rpc::ChannelOptions channel;
   channel.max_message_bytes = options.max_message_bytes;
   auto connect = [&](const std::string& target, const char* service) {
@@ -502,31 +503,20 @@ absl::StatusOr<v1::LocalFeatures> CoordinatorService::ExtractOnWorkers(
   *request.mutable_mesh()->mutable_mesh() = mesh;
   *request.mutable_params() = info.params;
   request.set_model_id(model_id);
-  rpc::RetryOptions retry;
-  retry.attempts = options_.call_attempts;
   if (info.options.extractor.method == FeatureMethod::kRldSift) {
     v1::ResampleRequest resample;
     *resample.mutable_mesh()->mutable_mesh() = mesh;
     resample.set_num_samples(info.options.extractor.rld.num_samples);
     resample.set_neighbors(info.options.extractor.rld.neighbors);
     v1::ResampleResponse resampled;
-    MESHSEEK_RETURN_IF_ERROR(rpc::RetryTransient(
-        [&] {
-          grpc::ClientContext context;
-          rpc::SetDeadline(&context, options_.extract_deadline);
-          return rpc::FromGrpcStatus(resample_->Resample(&context, resample, &resampled));
-        },
-        retry, &stop_));
+    MESHSEEK_RETURN_IF_ERROR(rpc::CallWithRetry(resample_.get(), &v1::Resample::Stub::Resample,
+                                                resample, &resampled, options_.extract_deadline,
+                                                retry_, &stop_));
     *request.mutable_resampled() = std::move(*resampled.mutable_graph());
   }
   v1::ExtractResponse response;
-  MESHSEEK_RETURN_IF_ERROR(rpc::RetryTransient(
-      [&] {
-        grpc::ClientContext context;
-        rpc::SetDeadline(&context, options_.extract_deadline);
-        return rpc::FromGrpcStatus(extract_->Extract(&context, request, &response));
-      },
-      retry, &stop_));
+  MESHSEEK_RETURN_IF_ERROR(rpc::CallWithRetry(extract_.get(), &v1::Extract::Stub::Extract, request,
+                                              &response, options_.extract_deadline, retry_, &stop_));
   return std::move(*response.mutable_features());
 }
 
@@ -536,15 +526,8 @@ absl::StatusOr<v1::SparseHistogram> CoordinatorService::EncodeOnCodebook(
   request.set_codebook_id(codebook_id);
   *request.mutable_features() = features;
   v1::EncodeResponse response;
-  rpc::RetryOptions retry;
-  retry.attempts = options_.call_attempts;
-  MESHSEEK_RETURN_IF_ERROR(rpc::RetryTransient(
-      [&] {
-        grpc::ClientContext context;
-        rpc::SetDeadline(&context, options_.call_deadline);
-        return rpc::FromGrpcStatus(codebook_->Encode(&context, request, &response));
-      },
-      retry, &stop_));
+  MESHSEEK_RETURN_IF_ERROR(rpc::CallWithRetry(codebook_.get(), &v1::Codebook::Stub::Encode, request,
+                                              &response, options_.call_deadline, retry_, &stop_));
   return std::move(*response.mutable_histogram());
 }
 
@@ -560,15 +543,8 @@ absl::Status CoordinatorService::AddToIndex(const std::string& collection,
   request.set_label(label);
   *request.mutable_histogram() = histogram;
   v1::AddModelResponse response;
-  rpc::RetryOptions retry;
-  retry.attempts = options_.call_attempts;
-  return rpc::RetryTransient(
-      [&] {
-        grpc::ClientContext context;
-        rpc::SetDeadline(&context, options_.call_deadline);
-        return rpc::FromGrpcStatus(index_->AddModel(&context, request, &response));
-      },
-      retry, &stop_);
+  return rpc::CallWithRetry(index_.get(), &v1::Index::Stub::AddModel, request, &response,
+                            options_.call_deadline, retry_, &stop_);
 }
 
 absl::Status CoordinatorService::ProcessModel(const ModelKey& key) {
@@ -713,8 +689,6 @@ void CoordinatorService::RunBuild(const std::string& job_id, const std::string& 
       members.push_back(std::move(m));
     }
   }
-  rpc::RetryOptions retry;
-  retry.attempts = options_.call_attempts;
   // 1. The codebook, unless a resumed build trained it already. Descriptors
   //    go in ingest order: the in-process pipeline's input, chunked.
   absl::Status trained = rpc::RetryTransient(
@@ -752,7 +726,7 @@ void CoordinatorService::RunBuild(const std::string& job_id, const std::string& 
         writer->WritesDone();
         return rpc::FromGrpcStatus(writer->Finish());
       },
-      retry, &stop_);
+      retry_, &stop_);
   if (!trained.ok()) return fail(Prefixed(trained, "codebook training: "));
   // 2. Encode and index every model not yet indexed with this codebook.
   std::vector<absl::Status> errors(members.size());
@@ -837,15 +811,8 @@ grpc::Status CoordinatorService::RemoveModel(grpc::ServerContext*,
   remove.set_collection(request->collection());
   remove.set_model_id(request->model_id());
   v1::RemoveModelResponse removed;
-  rpc::RetryOptions retry;
-  retry.attempts = options_.call_attempts;
-  absl::Status status = rpc::RetryTransient(
-      [&] {
-        grpc::ClientContext context;
-        rpc::SetDeadline(&context, options_.call_deadline);
-        return rpc::FromGrpcStatus(index_->RemoveModel(&context, remove, &removed));
-      },
-      retry);
+  absl::Status status = rpc::CallWithRetry(index_.get(), &v1::Index::Stub::RemoveModel, remove,
+                                           &removed, options_.call_deadline, retry_);
   if (!status.ok()) return rpc::ToGrpcStatus(status);
   absl::MutexLock lock(&mutex_);
   absl::StatusOr<Statement> erase = db_->Prepare(

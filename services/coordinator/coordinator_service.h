@@ -160,6 +160,8 @@ class CoordinatorService final : public v1::Coordinator::Service {
   void RunBuild(const std::string& job_id, const std::string& collection);
 
   const CoordinatorOptions options_;
+  // Retries of every call to a service (options_.call_attempts tries).
+  rpc::RetryOptions retry_;
   std::unique_ptr<v1::Resample::Stub> resample_;
   std::unique_ptr<v1::Extract::Stub> extract_;
   std::unique_ptr<v1::Codebook::Stub> codebook_;
