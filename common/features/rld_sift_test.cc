@@ -86,6 +86,24 @@ TEST(ScaleSpaceMethodsTest, LdSiftFindsNothingOnAPolygonSoup) {
   EXPECT_EQ(c->descriptors, d->descriptors);
 }
 
+// The two steps the resample and extract services run separately give the
+// one-step result exactly, and a malformed graph from outside is refused.
+TEST(ScaleSpaceMethodsTest, RldSiftInTwoStepsEqualsOneStep) {
+  const TriangleMesh mesh = testing_meshes::Icosphere(3);
+  RldSiftOptions options;
+  options.num_samples = 3000;
+  auto whole = ExtractRldSift(mesh, options);
+  auto graph = ResampleSurfaceGraph(mesh, options.num_samples, options.neighbors);
+  ASSERT_TRUE(whole.ok() && graph.ok());
+  auto described = DescribeRldSift(mesh, *graph, options);
+  ASSERT_TRUE(described.ok()) << described.status();
+  EXPECT_GT(whole->size(), 0u);
+  EXPECT_EQ(described->descriptors, whole->descriptors);
+  graph->neighbors[0] = static_cast<uint32_t>(graph->size());
+  EXPECT_EQ(DescribeRldSift(mesh, *graph, options).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
 // Rigid motion and uniform scale: every stage of both methods is
 // similarity-covariant, so the interest points map onto each other and their
 // descriptors nearly agree. Tolerance as for DLD-SIFT: the mean distance from
