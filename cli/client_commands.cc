@@ -178,7 +178,7 @@ absl::Status IngestModels(v1::Coordinator::Stub* stub, const std::string& collec
   while (true) {
     grpc::ClientContext context;
     auto stream = stub->Ingest(&context);
-    std::map<std::string, std::size_t> sent;  // model id -> index, not yet acknowledged
+    std::map<std::string, std::size_t> sent;  // model id -> index, awaiting acknowledgement
     absl::Status read_error;
     // Acknowledgements arrive on their own thread while this one sends.
     std::thread reader([&] {

@@ -1,11 +1,9 @@
 #include "common/features/ld_sift.h"
 
-#include <algorithm>
 
 #include "common/base/status_macros.h"
 #include "common/features/local_depth_sift.h"
 #include "common/geometry/mesh_vertex_graph.h"
-#include "common/geometry/point_grid.h"
 
 namespace meshseek {
 
@@ -23,22 +21,18 @@ absl::StatusOr<LocalFeatures> ExtractLdSift(const TriangleMesh& mesh,
   const MeshVertexGraph vertex_graph = BuildMeshVertexGraph(mesh);
   const PointGraph& graph = vertex_graph.graph;
   std::vector<InterestPoint> points = DetectInterestPoints(graph, options.scale_space);
-  LocalFeatures features;
-  if (!points.empty()) {
-    const PointGrid grid(graph.positions, std::max(MedianScale(points), 1e-12f));
-    LocalDepthSift describer(mesh, options.depth_image, options.descriptor);
-    std::vector<uint32_t> support;
-    for (const InterestPoint& ip : points) {
-      const Vec3f& p = graph.positions[ip.vertex];
-      const Vec3d normal(vertex_graph.normals[ip.vertex]);
-      const auto axes = SupportAxes(graph.positions, grid, p, ip.scale, false, &support);
-      if (!axes || SquaredNorm(normal) < 0.5) continue;
-      // The image's up axis: the main PCA axis, made orthogonal to the normal.
-      Vec3d up = axes->axes[0] - normal * Dot(axes->axes[0], normal);
-      if (SquaredNorm(up) < 1e-12) up = axes->axes[1] - normal * Dot(axes->axes[1], normal);
-      describer.Describe({Vec3d(p), Normalized(up), normal, ip.scale}, false, ip.level, &features);
-    }
-  }
+  LocalFeatures features = DescribeInterestPoints(
+      mesh, graph.positions, points, /*weighted=*/false, /*two_views=*/false,
+      options.depth_image, options.descriptor,
+      [&](const InterestPoint& ip, const Vec3f& p,
+          const PrincipalAxes& axes) -> std::optional<ViewFrame> {
+        const Vec3d normal(vertex_graph.normals[ip.vertex]);
+        if (SquaredNorm(normal) < 0.5) return std::nullopt;
+        // The image's up axis: the main PCA axis, made orthogonal to the normal.
+        Vec3d up = axes.axes[0] - normal * Dot(axes.axes[0], normal);
+        if (SquaredNorm(up) < 1e-12) up = axes.axes[1] - normal * Dot(axes.axes[1], normal);
+        return ViewFrame{Vec3d(p), Normalized(up), normal, ip.scale};
+      });
   if (detected != nullptr) *detected = std::move(points);
   return features;
 }

@@ -1,5 +1,7 @@
 #include "common/features/local_depth_sift.h"
 
+#include <algorithm>
+
 namespace meshseek {
 
 std::optional<PrincipalAxes> SupportAxes(const std::vector<Vec3f>& points,
@@ -35,6 +37,29 @@ void LocalDepthSift::Describe(const ViewFrame& frame,
           {Vec3f(frame.point), forward, Vec3f(frame.up), static_cast<float>(frame.radius), level});
     }
   }
+}
+
+LocalFeatures DescribeInterestPoints(const TriangleMesh& mesh,
+                                     const std::vector<Vec3f>& positions,
+                                     const std::vector<InterestPoint>& points,
+                                     bool weighted,
+                                     bool two_views,
+                                     const DepthImageOptions& image_options,
+                                     const SiftDescriptorOptions& descriptor_options,
+                                     const InterestPointFrame& make_frame) {
+  LocalFeatures features;
+  if (points.empty()) return features;
+  const PointGrid grid(positions, std::max(MedianScale(points), 1e-12f));
+  LocalDepthSift describer(mesh, image_options, descriptor_options);
+  std::vector<uint32_t> support;
+  for (const InterestPoint& ip : points) {
+    const Vec3f& p = positions[ip.vertex];
+    const auto axes = SupportAxes(positions, grid, p, ip.scale, weighted, &support);
+    if (!axes) continue;
+    const std::optional<ViewFrame> frame = make_frame(ip, p, *axes);
+    if (frame) describer.Describe(*frame, two_views, ip.level, &features);
+  }
+  return features;
 }
 
 }  // namespace meshseek

@@ -6,11 +6,13 @@
 #ifndef MESHSEEK_COMMON_FEATURES_LOCAL_DEPTH_SIFT_H_
 #define MESHSEEK_COMMON_FEATURES_LOCAL_DEPTH_SIFT_H_
 
+#include <functional>
 #include <optional>
 #include <vector>
 
 #include "common/features/depth_image.h"
 #include "common/features/local_features.h"
+#include "common/features/scale_space.h"
 #include "common/features/sift_descriptor.h"
 #include "common/geometry/mesh.h"
 #include "common/geometry/point_grid.h"
@@ -50,6 +52,25 @@ class LocalDepthSift {
   DepthSiftDescriber describer_;
   DepthImage front_, back_;
 };
+
+// The view frame of a detected point, made from the point and the PCA axes of
+// its support; nullopt skips the point.
+using InterestPointFrame = std::function<std::optional<ViewFrame>(
+    const InterestPoint& point, const Vec3f& position, const PrincipalAxes& axes)>;
+
+// Describes detected interest points (vertices of `positions`, with their
+// scales), as LD-SIFT and RLD-SIFT both do: the support axes of the points of
+// `positions` within each point's scale (SupportAxes, `weighted`), the frame
+// `make_frame` makes of them, and LocalDepthSift's views of `mesh`. The two
+// methods differ only in `make_frame`, `weighted` and `two_views`.
+LocalFeatures DescribeInterestPoints(const TriangleMesh& mesh,
+                                     const std::vector<Vec3f>& positions,
+                                     const std::vector<InterestPoint>& points,
+                                     bool weighted,
+                                     bool two_views,
+                                     const DepthImageOptions& image_options,
+                                     const SiftDescriptorOptions& descriptor_options,
+                                     const InterestPointFrame& make_frame);
 
 }  // namespace meshseek
 

@@ -1,12 +1,10 @@
 #include "common/features/rld_sift.h"
 
-#include <algorithm>
 
 #include "absl/strings/str_cat.h"
 #include "common/base/status_macros.h"
 #include "common/features/local_depth_sift.h"
 #include "common/geometry/point_graph.h"
-#include "common/geometry/point_grid.h"
 
 namespace meshseek {
 
@@ -43,22 +41,12 @@ absl::StatusOr<LocalFeatures> DescribeRldSift(const TriangleMesh& mesh,
   MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));
   MESHSEEK_RETURN_IF_ERROR(ValidatePointGraph(graph));
   std::vector<InterestPoint> points = DetectInterestPoints(graph, options.scale_space);
-  LocalFeatures features;
-  if (!points.empty()) {
-    const PointGrid grid(graph.positions, std::max(MedianScale(points), 1e-12f));
-    LocalDepthSift describer(mesh, options.depth_image, options.descriptor);
-    std::vector<uint32_t> support;
-    for (const InterestPoint& ip : points) {
-      const Vec3f& p = graph.positions[ip.vertex];
-      const auto axes =
-          SupportAxes(graph.positions, grid, p, ip.scale, options.weighted_frame, &support);
-      if (!axes) continue;
-      describer.Describe({Vec3d(p), axes->axes[0], axes->axes[2], ip.scale},
-                         options.two_views,
-                         ip.level,
-                         &features);
-    }
-  }
+  LocalFeatures features = DescribeInterestPoints(
+      mesh, graph.positions, points, options.weighted_frame, options.two_views,
+      options.depth_image, options.descriptor,
+      [](const InterestPoint& ip, const Vec3f& p, const PrincipalAxes& axes) {
+        return std::optional<ViewFrame>(ViewFrame{Vec3d(p), axes.axes[0], axes.axes[2], ip.scale});
+      });
   if (detected != nullptr) *detected = std::move(points);
   return features;
 }
