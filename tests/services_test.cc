@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 #include "common/eval/manifest.h"
 #include "common/geometry/mesh_io.h"
 #include "common/pipeline/retrieval_pipeline.h"
@@ -102,6 +103,20 @@ class Server {
     }
     return false;
   }
+  // Waits up to `within` for the process to exit by itself; its exit code,
+  // or -1 if it is still running.
+  int WaitExit(absl::Duration within) {
+    const absl::Time end = absl::Now() + within;
+    while (pid_ > 0 && absl::Now() < end) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return -1;
+  }
   int port() const { return port_; }
 
  private:
@@ -112,10 +127,11 @@ class Server {
 };
 
 // The whole stack: resample, `extract_workers` extract workers, codebook,
-// index and coordinator, state under `dir`.
+// `index_shards` index servers and coordinator, state under `dir`.
 class Stack {
  public:
-  Stack(const std::string& dir, int extract_workers, int max_pending = 512) : dir_(dir) {
+  Stack(const std::string& dir, int extract_workers, int max_pending = 512, int index_shards = 1)
+      : dir_(dir) {
     resample_ = std::make_unique<Server>("resample", std::vector<std::string>{}, FreePort());
     std::string targets;
     for (int w = 0; w < extract_workers; ++w) {
@@ -125,20 +141,28 @@ class Stack {
     }
     codebook_ = std::make_unique<Server>(
         "codebook", std::vector<std::string>{"--data_dir=" + dir + "/codebook"}, FreePort());
-    index_ = std::make_unique<Server>(
-        "index", std::vector<std::string>{"--data_dir=" + dir + "/index"}, FreePort());
+    std::string shards;
+    for (int s = 0; s < index_shards; ++s) {
+      index_.push_back(std::make_unique<Server>(
+          "index", std::vector<std::string>{absl::StrCat("--data_dir=", dir, "/index", s)},
+          FreePort()));
+      absl::StrAppend(&shards, shards.empty() ? "" : ",", Address(index_.back()->port()));
+    }
     coordinator_args_ = {"--data_dir=" + dir + "/coordinator",
                          "--resample=" + Address(resample_->port()),
                          "--extract=ipv4:" + targets,
                          "--codebook=" + Address(codebook_->port()),
-                         "--index=" + Address(index_->port()),
+                         "--index=" + shards,
                          absl::StrCat("--max_in_flight=", extract_workers),
                          absl::StrCat("--max_pending=", max_pending)};
     coordinator_ = std::make_unique<Server>("coordinator", coordinator_args_, FreePort());
   }
   bool WaitServing() {
-    for (Server* s : {resample_.get(), codebook_.get(), index_.get(), coordinator_.get()}) {
+    for (Server* s : {resample_.get(), codebook_.get(), coordinator_.get()}) {
       if (!s->WaitServing()) return false;
+    }
+    for (auto& i : index_) {
+      if (!i->WaitServing()) return false;
     }
     for (auto& e : extract_) {
       if (!e->WaitServing()) return false;
@@ -149,14 +173,14 @@ class Stack {
     return v1::Coordinator::NewStub(rpc::MakeChannel(Address(coordinator_->port())));
   }
   Server& coordinator() { return *coordinator_; }
-  Server& index() { return *index_; }
+  Server& index(int shard = 0) { return *index_[shard]; }
   Server& extract(int i) { return *extract_[i]; }
   Server& codebook() { return *codebook_; }
 
  private:
   std::string dir_;
-  std::unique_ptr<Server> resample_, codebook_, index_, coordinator_;
-  std::vector<std::unique_ptr<Server>> extract_;
+  std::unique_ptr<Server> resample_, codebook_, coordinator_;
+  std::vector<std::unique_ptr<Server>> extract_, index_;
   std::vector<std::string> coordinator_args_;
 };
 
@@ -287,6 +311,39 @@ class ServicesTest : public ::testing::Test {
       }
     }
     return matrix;
+  }
+
+  // Query with model i's mesh, top_k results; `deadline` for the whole call.
+  static grpc::Status Query(v1::Coordinator::Stub* stub, const std::string& collection,
+                            std::size_t i, uint32_t top_k, absl::Duration deadline,
+                            v1::QueryResponse* response) {
+    grpc::ClientContext context;
+    rpc::SetDeadline(&context, deadline);
+    v1::QueryRequest request;
+    request.set_collection(collection);
+    request.set_top_k(top_k);
+    rpc::MeshToProto(*ReadMesh((*models_)[i].path), request.mutable_mesh()->mutable_mesh());
+    return stub->Query(&context, request, response);
+  }
+
+  // The top_k of row i of the reference matrix: (distance, manifest order).
+  static std::vector<std::pair<std::string, float>> ReferenceTop(std::size_t i, std::size_t top_k) {
+    const std::size_t n = models_->size();
+    std::vector<std::size_t> order(n);
+    for (std::size_t j = 0; j < n; ++j) order[j] = j;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return (*reference_)[i * n + a] < (*reference_)[i * n + b];
+    });
+    std::vector<std::pair<std::string, float>> top;
+    for (std::size_t r = 0; r < top_k; ++r) {
+      top.emplace_back((*models_)[order[r]].id, (*reference_)[i * n + order[r]]);
+    }
+    return top;
+  }
+  static std::vector<std::pair<std::string, float>> Results(const v1::QueryResponse& response) {
+    std::vector<std::pair<std::string, float>> out;
+    for (const auto& r : response.results()) out.emplace_back(r.model_id(), r.distance());
+    return out;
   }
 
   static std::string* dir_;
@@ -465,6 +522,78 @@ TEST_F(ServicesTest, BadInputGetsTheRightCodeANamedProblemAndServersKeepServing)
     EXPECT_EQ(response.results(0).model_id(), (*models_)[0].id);
     EXPECT_EQ(response.results(0).distance(), 0.0f);
   }
+}
+
+TEST_F(ServicesTest, TwoIndexShardsGiveTheResultsOfOneAndNeverAPartialAnswer) {
+  Stack stack(*dir_ + "/shards", 1, 512, /*index_shards=*/2);
+  ASSERT_TRUE(stack.WaitServing());
+  auto stub = stack.Coordinator();
+  ASSERT_TRUE(CreateCollection(stub.get(), "synthetic").ok());
+  const std::size_t n = models_->size();
+  std::set<std::string> jobs;
+  ASSERT_EQ(Ingest(stub.get(), "synthetic", 0, n, &jobs), n);
+  WaitJob(stub.get(), *jobs.begin());
+  const v1::JobStatus build = WaitJob(stub.get(), Build(stub.get(), "synthetic"));
+  ASSERT_EQ(build.state(), v1::JOB_STATE_SUCCEEDED) << build.DebugString();
+
+  // Each model on exactly one shard, both shards used.
+  std::set<std::string> placed;
+  std::size_t total = 0;
+  for (int s = 0; s < 2; ++s) {
+    auto index = v1::Index::NewStub(rpc::MakeChannel(Address(stack.index(s).port())));
+    grpc::ClientContext context;
+    v1::ListModelsRequest list;
+    list.set_collection("synthetic");
+    v1::ListModelsResponse listed;
+    ASSERT_TRUE(index->ListModels(&context, list, &listed).ok());
+    EXPECT_GT(listed.model_ids_size(), static_cast<int>(n / 4)) << "shard " << s;
+    total += listed.model_ids_size();
+    placed.insert(listed.model_ids().begin(), listed.model_ids().end());
+  }
+  EXPECT_EQ(total, n);
+  EXPECT_EQ(placed.size(), n);
+
+  // The merged matrix and top-k are the one-index results, bit for bit.
+  EXPECT_EQ(Evaluate(stub.get(), "synthetic"), *reference_);
+  for (std::size_t i : {0u, 17u, 40u}) {
+    v1::QueryResponse response;
+    const grpc::Status status = Query(stub.get(), "synthetic", i, 7, absl::Seconds(30), &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(Results(response), ReferenceTop(i, 7)) << "query " << i;
+  }
+
+  // A shard that is down: the query fails (here at the client's deadline,
+  // while the coordinator retries), it does not answer from one shard.
+  stack.index(1).Kill(SIGKILL);
+  {
+    v1::QueryResponse response;
+    const grpc::Status status = Query(stub.get(), "synthetic", 0, 7, absl::Seconds(3), &response);
+    EXPECT_FALSE(status.ok()) << Results(response).size() << " results from one shard";
+    EXPECT_THAT(status.error_code(), ::testing::AnyOf(grpc::StatusCode::UNAVAILABLE,
+                                                      grpc::StatusCode::DEADLINE_EXCEEDED));
+  }
+  // A shard restarting while a query waits: the retry gets the full answer.
+  std::thread restart([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(800));
+    stack.index(1).Start();
+  });
+  {
+    v1::QueryResponse response;
+    const grpc::Status status = Query(stub.get(), "synthetic", 17, 7, absl::Seconds(60), &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(Results(response), ReferenceTop(17, 7));
+  }
+  restart.join();
+  EXPECT_EQ(Evaluate(stub.get(), "synthetic"), *reference_);
+
+  // The coordinator refuses to run with another number of shards.
+  stack.coordinator().Kill(SIGKILL);
+  Server other("coordinator",
+               {"--data_dir=" + *dir_ + "/shards/coordinator", "--resample=127.0.0.1:1",
+                "--extract=127.0.0.1:1", "--codebook=127.0.0.1:1",
+                "--index=" + Address(stack.index(0).port())},
+               FreePort());
+  EXPECT_GT(other.WaitExit(absl::Seconds(20)), 0);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <limits>
 #include <numeric>
+#include <optional>
 
 #include "absl/strings/str_cat.h"
 #include "common/base/file_io.h"
@@ -14,6 +15,7 @@
 #include "common/base/status_macros.h"
 #include "common/eval/distance_matrix.h"
 #include "common/geometry/mesh_io.h"
+#include "common/search/kl_inverted_index.h"
 
 namespace meshseek {
 namespace {
@@ -129,45 +131,42 @@ absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
   return histograms;
 }
 
+namespace {
+
+// The histograms in an inverted index, doc i = histograms[i] (empty ones as
+// models without features); nullopt when every histogram is empty.
+absl::StatusOr<std::optional<KlInvertedIndex>> IndexHistograms(
+    const std::vector<std::vector<float>>& histograms, const RetrievalPipelineOptions& options) {
+  const auto first = std::find_if(histograms.begin(), histograms.end(),
+                                  [](const std::vector<float>& h) { return !h.empty(); });
+  if (first == histograms.end()) return std::nullopt;
+  MESHSEEK_ASSIGN_OR_RETURN(
+      KlInvertedIndex index,
+      KlInvertedIndex::Create(static_cast<uint32_t>(first->size()), options.kl));
+  SparseHistogram empty;
+  empty.vocabulary = index.vocabulary();
+  for (std::size_t i = 0; i < histograms.size(); ++i) {
+    MESHSEEK_RETURN_IF_ERROR(index.Upsert(
+        static_cast<uint32_t>(i), histograms[i].empty() ? empty : SparseFromDense(histograms[i])));
+  }
+  return std::optional<KlInvertedIndex>(std::move(index));
+}
+
+}  // namespace
+
 absl::StatusOr<std::vector<float>> RankCollection(const std::vector<std::vector<float>>& histograms,
                                                   const RetrievalPipelineOptions& options) {
   const std::size_t n = histograms.size();
-  std::vector<std::size_t> present;
-  std::vector<std::vector<float>> compared;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (histograms[i].empty()) continue;
-    present.push_back(i);
-    compared.push_back(histograms[i]);
+  MESHSEEK_ASSIGN_OR_RETURN(const std::optional<KlInvertedIndex> index,
+                            IndexHistograms(histograms, options));
+  if (!index.has_value()) {
+    std::vector<float> distances(n * n, std::numeric_limits<float>::infinity());
+    for (std::size_t i = 0; i < n; ++i) distances[i * n + i] = 0;
+    return distances;
   }
-  std::vector<float> distances(n * n, std::numeric_limits<float>::infinity());
-  for (std::size_t i = 0; i < n; ++i) distances[i * n + i] = 0;
-  if (compared.empty()) return distances;
-  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<float> sub,
-                            SymmetricKlDistanceMatrix(compared, options.kl, options.num_threads));
-  const std::size_t m = present.size();
-  for (std::size_t a = 0; a < m; ++a) {
-    for (std::size_t b = 0; b < m; ++b) distances[present[a] * n + present[b]] = sub[a * m + b];
-  }
-  return distances;
-}
-
-absl::StatusOr<std::vector<float>> QueryDistances(const std::vector<float>& query,
-                                                  const std::vector<std::vector<float>>& histograms,
-                                                  const RetrievalPipelineOptions& options) {
-  std::vector<float> distances(histograms.size(), std::numeric_limits<float>::infinity());
-  if (query.empty()) return distances;
-  std::vector<std::size_t> present;
-  std::vector<std::vector<float>> compared;
-  for (std::size_t i = 0; i < histograms.size(); ++i) {
-    if (histograms[i].empty()) continue;
-    present.push_back(i);
-    compared.push_back(histograms[i]);
-  }
-  if (compared.empty()) return distances;
-  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<float> sub,
-                            SymmetricKlDistances(query, compared, options.kl, options.num_threads));
-  for (std::size_t a = 0; a < present.size(); ++a) distances[present[a]] = sub[a];
-  return distances;
+  std::vector<uint32_t> docs(n);
+  std::iota(docs.begin(), docs.end(), 0u);
+  return index->DistanceMatrix(docs, options.num_threads);
 }
 
 absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<ManifestEntry>& models,

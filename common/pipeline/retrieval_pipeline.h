@@ -66,19 +66,13 @@ absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
     const std::vector<LocalFeatures>& features,
     const RetrievalPipelineOptions& options);
 
-// All-pairs symmetric KL distances, N x N row-major. A model without features
+// All-pairs symmetric KL distances, N x N row-major, by the exact inverted
+// file (common/search/kl_inverted_index.h). A model without features
 // (empty histogram) cannot be compared: its distance to every other model is
 // +infinity (0 to itself), so it is ranked last by every query and, as a
 // query, finds all others tied (broken by index). Such models are counted in
 // the report rather than silently given an arbitrary histogram.
 absl::StatusOr<std::vector<float>> RankCollection(const std::vector<std::vector<float>>& histograms,
-                                                  const RetrievalPipelineOptions& options);
-
-// Distances from one query histogram to each of `histograms` (the search
-// path), with the same rule for empty histograms as RankCollection: +infinity
-// to or from a model without features.
-absl::StatusOr<std::vector<float>> QueryDistances(const std::vector<float>& query,
-                                                  const std::vector<std::vector<float>>& histograms,
                                                   const RetrievalPipelineOptions& options);
 
 struct StageTimings {

@@ -186,26 +186,22 @@ void GraphToProto(const PointGraph& graph, v1::PointGraph* out) {
   out->mutable_neighbors()->Add(graph.neighbors.begin(), graph.neighbors.end());
 }
 
-absl::StatusOr<std::vector<float>> HistogramFromProto(const v1::SparseHistogram& h) {
-  if (h.bins_size() != h.weights_size()) {
-    return absl::InvalidArgumentError(absl::StrCat("histogram: ", h.bins_size(), " bins but ",
-                                                   h.weights_size(), " weights"));
-  }
-  if (h.bins_size() == 0) return std::vector<float>();
-  std::vector<float> dense(h.size(), 0.0f);
-  for (int i = 0; i < h.bins_size(); ++i) {
-    if (h.bins(i) >= h.size() || (i > 0 && h.bins(i) <= h.bins(i - 1))) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "histogram: bin ", h.bins(i), " at position ", i,
-          " is out of order or not below the vocabulary size ", h.size()));
-    }
-    if (!std::isfinite(h.weights(i)) || h.weights(i) < 0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("histogram: bin ", h.bins(i), " has weight ", h.weights(i)));
-    }
-    dense[h.bins(i)] = h.weights(i);
-  }
-  return dense;
+absl::StatusOr<SparseHistogram> SparseHistogramFromProto(const v1::SparseHistogram& h,
+                                                         absl::string_view name) {
+  SparseHistogram histogram;
+  histogram.vocabulary = h.size();
+  histogram.words.assign(h.bins().begin(), h.bins().end());
+  histogram.weights.assign(h.weights().begin(), h.weights().end());
+  // The weights of a histogram sum to 1; the tolerance is the core's default.
+  MESHSEEK_RETURN_IF_ERROR(histogram.Validate(name, KlDivergenceOptions().sum_tolerance));
+  return histogram;
+}
+
+void SparseHistogramToProto(const SparseHistogram& histogram, v1::SparseHistogram* out) {
+  out->Clear();
+  out->set_size(histogram.vocabulary);
+  out->mutable_bins()->Add(histogram.words.begin(), histogram.words.end());
+  out->mutable_weights()->Add(histogram.weights.begin(), histogram.weights.end());
 }
 
 void HistogramToProto(const std::vector<float>& dense,

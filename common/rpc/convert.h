@@ -13,6 +13,7 @@
 #include "common/geometry/mesh.h"
 #include "common/geometry/point_graph.h"
 #include "common/pipeline/retrieval_pipeline.h"
+#include "common/search/sparse_histogram.h"
 #include "meshseek/v1/types.pb.h"
 
 namespace meshseek::rpc {
@@ -29,10 +30,12 @@ void FeaturesToProto(const LocalFeatures& features, v1::LocalFeatures* out);
 absl::StatusOr<PointGraph> GraphFromProto(const v1::PointGraph& graph);
 void GraphToProto(const PointGraph& graph, v1::PointGraph* out);
 
-// Dense histogram of length size (empty when the message has no bins: a model
-// without features). Bins must increase strictly and be < size; weights finite
-// and non-negative.
-absl::StatusOr<std::vector<float>> HistogramFromProto(const v1::SparseHistogram& histogram);
+// The histogram as sent (no bins: a model without features), checked with
+// SparseHistogram::Validate under `name` (which bounds the declared size
+// before anything depends on it).
+absl::StatusOr<SparseHistogram> SparseHistogramFromProto(const v1::SparseHistogram& histogram,
+                                                         absl::string_view name);
+void SparseHistogramToProto(const SparseHistogram& histogram, v1::SparseHistogram* out);
 // The non-zero bins of `dense` (length = vocabulary size; empty = no features).
 void HistogramToProto(const std::vector<float>& dense,
                       std::size_t vocabulary_size,

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "common/geometry/test_meshes.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
 namespace meshseek::rpc {
@@ -91,14 +92,25 @@ TEST(ConvertTest, HistogramsAreSparseAndExact) {
   v1::SparseHistogram proto;
   HistogramToProto(dense, dense.size(), &proto);
   EXPECT_EQ(proto.bins_size(), 2);
-  auto back = HistogramFromProto(proto);
-  ASSERT_TRUE(back.ok());
-  EXPECT_EQ(*back, dense);
+  auto back = SparseHistogramFromProto(proto, "h");
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(DenseFromSparse(*back), dense);
+  v1::SparseHistogram again;
+  SparseHistogramToProto(*back, &again);
+  EXPECT_EQ(again.SerializeAsString(), proto.SerializeAsString());
   HistogramToProto({}, 4, &proto);
-  EXPECT_TRUE(HistogramFromProto(proto)->empty());  // a model without features
+  EXPECT_TRUE(SparseHistogramFromProto(proto, "h")->empty());  // a model without features
   proto.add_bins(4);
   proto.add_weights(1.0f);
-  EXPECT_EQ(HistogramFromProto(proto).status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(SparseHistogramFromProto(proto, "h").status().code(),
+            absl::StatusCode::kInvalidArgument);
+  // A declared size of four billion is refused before anything is allocated.
+  proto.Clear();
+  proto.set_size(4000000000u);
+  proto.add_bins(7);
+  proto.add_weights(1.0f);
+  EXPECT_THAT(std::string(SparseHistogramFromProto(proto, "model 'x'").status().message()),
+              ::testing::HasSubstr("model 'x' has vocabulary size 4000000000"));
 }
 
 TEST(ConvertTest, UnsetParamsAreTheCoreDefaults) {

@@ -60,6 +60,7 @@ absl::Status CoordinatorOptions::Validate() const {
       return absl::InvalidArgumentError(absl::StrCat("coordinator: the ", name, " target is empty"));
     }
   }
+  MESHSEEK_RETURN_IF_ERROR(IndexShards::ParseTargets(index_target).status());
   if (max_in_flight < 1 || max_in_flight > 1024) {
     return absl::InvalidArgumentError(
         absl::StrCat("coordinator: max_in_flight must be in [1, 1024], got ", max_in_flight));
@@ -86,7 +87,8 @@ CoordinatorService::CoordinatorService(const CoordinatorOptions& options) : opti
   resample_ = v1::Resample::NewStub(connect(options.resample_target, "meshseek.v1.Resample"));
   extract_ = v1::Extract::NewStub(connect(options.extract_target, "meshseek.v1.Extract"));
   codebook_ = v1::Codebook::NewStub(connect(options.codebook_target, "meshseek.v1.Codebook"));
-  index_ = v1::Index::NewStub(connect(options.index_target, "meshseek.v1.Index"));
+  index_ = std::make_unique<IndexShards>(*IndexShards::ParseTargets(options.index_target), channel,
+                                         options.call_deadline, retry_, &stop_);
 }
 
 absl::StatusOr<std::unique_ptr<CoordinatorService>> CoordinatorService::Create(
@@ -120,9 +122,24 @@ absl::Status CoordinatorService::Open() {
       seq INTEGER PRIMARY KEY AUTOINCREMENT, id TEXT UNIQUE, kind TEXT NOT NULL,
       collection TEXT NOT NULL, state INTEGER NOT NULL, message TEXT NOT NULL DEFAULT '',
       total INTEGER NOT NULL DEFAULT 0, stream_open INTEGER NOT NULL DEFAULT 0);
+    CREATE TABLE IF NOT EXISTS settings (key TEXT PRIMARY KEY, value INTEGER NOT NULL);
     -- Streams do not survive a restart; their models do.
     UPDATE jobs SET stream_open = 0;
   )sql"));
+  // Models are placed on index shards by hash modulo their number: another
+  // number would look for every model on the wrong shard.
+  MESHSEEK_ASSIGN_OR_RETURN(
+      Statement shards,
+      db_->Prepare("INSERT INTO settings (key, value) VALUES ('index_shards', ?) "
+                   "ON CONFLICT (key) DO UPDATE SET value = value RETURNING value"));
+  shards.Bind(1, static_cast<int64_t>(index_->size()));
+  MESHSEEK_ASSIGN_OR_RETURN(const bool stored, shards.Step());
+  if (stored && shards.ColumnInt(0) != static_cast<int64_t>(index_->size())) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "coordinator: ", options_.data_dir, " was used with ", shards.ColumnInt(0),
+        " index shards, --index lists ", index_->size(),
+        "; models would be looked for on the wrong shards"));
+  }
   MESHSEEK_ASSIGN_OR_RETURN(Statement count,
                             db_->Prepare("SELECT COUNT(*) FROM models WHERE state = 0"));
   MESHSEEK_ASSIGN_OR_RETURN(const bool row, count.Step());
@@ -542,9 +559,7 @@ absl::Status CoordinatorService::AddToIndex(const std::string& collection,
   request.set_ordinal(ordinal);
   request.set_label(label);
   *request.mutable_histogram() = histogram;
-  v1::AddModelResponse response;
-  return rpc::CallWithRetry(index_.get(), &v1::Index::Stub::AddModel, request, &response,
-                            options_.call_deadline, retry_, &stop_);
+  return index_->Add(request);
 }
 
 absl::Status CoordinatorService::ProcessModel(const ModelKey& key) {
@@ -790,12 +805,9 @@ grpc::Status CoordinatorService::Query(grpc::ServerContext*,
   *search.mutable_histogram() = *histogram;
   search.set_top_k(request->top_k());
   search.set_kl_epsilon(info->options.kl.epsilon);
-  v1::SearchResponse found;
-  grpc::ClientContext context;
-  rpc::SetDeadline(&context, options_.call_deadline);
-  grpc::Status status = index_->Search(&context, search, &found);
-  if (!status.ok()) return status;
-  *response->mutable_results() = std::move(*found.mutable_results());
+  absl::StatusOr<std::vector<v1::ScoredModel>> found = index_->Search(search);
+  if (!found.ok()) return rpc::ToGrpcStatus(found.status());
+  for (v1::ScoredModel& m : *found) *response->add_results() = std::move(m);
   response->set_query_features(features->count());
   return grpc::Status::OK;
 }
@@ -807,13 +819,8 @@ grpc::Status CoordinatorService::RemoveModel(grpc::ServerContext*,
   if (!info.ok()) return rpc::ToGrpcStatus(info.status());
   // The index first: a failure there leaves the model in both, and the
   // removal can simply be retried.
-  v1::RemoveModelRequest remove;
-  remove.set_collection(request->collection());
-  remove.set_model_id(request->model_id());
-  v1::RemoveModelResponse removed;
-  absl::Status status = rpc::CallWithRetry(index_.get(), &v1::Index::Stub::RemoveModel, remove,
-                                           &removed, options_.call_deadline, retry_);
-  if (!status.ok()) return rpc::ToGrpcStatus(status);
+  absl::StatusOr<bool> removed = index_->Remove(request->collection(), request->model_id());
+  if (!removed.ok()) return rpc::ToGrpcStatus(removed.status());
   absl::MutexLock lock(&mutex_);
   absl::StatusOr<Statement> erase = db_->Prepare(
       "DELETE FROM models WHERE collection = ? AND model_id = ? RETURNING state");
@@ -853,34 +860,27 @@ grpc::Status CoordinatorService::Evaluate(grpc::ServerContext* context,
       feature_counts[select->ColumnText(0)] = static_cast<uint32_t>(select->ColumnInt(1));
     }
   }
-  v1::DistanceMatrixRequest matrix;
-  matrix.set_collection(request->collection());
-  matrix.set_kl_epsilon(info->options.kl.epsilon);
-  grpc::ClientContext call;
-  rpc::SetDeadline(&call, absl::Minutes(30));
-  auto reader = index_->DistanceMatrix(&call, matrix);
-  v1::DistanceRow row;
   v1::EvaluateRow out;
   uint64_t rows = 0;
-  while (reader->Read(&row)) {
-    if (context->IsCancelled()) {
-      call.TryCancel();
-      break;
-    }
-    out.set_model_id(row.model_id());
-    out.set_label(row.label());
-    *out.mutable_distances() = std::move(*row.mutable_distances());
-    out.set_features(feature_counts[row.model_id()]);
-    if (!writer->Write(out)) call.TryCancel();
-    ++rows;
-  }
-  status = reader->Finish();
-  if (status.ok() && rows != collection.models()) {
+  const absl::Status streamed = index_->ForEachDistanceRow(
+      request->collection(), info->options.kl.epsilon,
+      [&](const IndexShards::Row& row) -> absl::Status {
+        if (context->IsCancelled()) return absl::CancelledError("evaluate: cancelled");
+        out.set_model_id(row.model->model_id());
+        out.set_label(row.model->label());
+        out.mutable_distances()->Assign(row.distances.begin(), row.distances.end());
+        out.set_features(feature_counts[row.model->model_id()]);
+        if (!writer->Write(out)) return absl::CancelledError("evaluate: client went away");
+        ++rows;
+        return absl::OkStatus();
+      });
+  if (!streamed.ok()) return rpc::ToGrpcStatus(streamed);
+  if (rows != collection.models()) {
     return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
                         absl::StrCat("index returned ", rows, " rows for ", collection.models(),
                                      " models; build again"));
   }
-  return status;
+  return grpc::Status::OK;
 }
 
 }  // namespace meshseek

@@ -44,6 +44,7 @@
 #include "meshseek/v1/extract.grpc.pb.h"
 #include "meshseek/v1/index.grpc.pb.h"
 #include "meshseek/v1/resample.grpc.pb.h"
+#include "services/coordinator/index_shards.h"
 
 namespace meshseek {
 
@@ -55,6 +56,8 @@ struct CoordinatorOptions {
   std::string resample_target;
   std::string extract_target;
   std::string codebook_target;
+  /// One target per index shard, separated by commas (index_shards.h); the
+  /// number of shards is fixed once the data folder has been used.
   std::string index_target;
   /// Models being resampled/extracted at once, over all workers (the
   /// dispatcher threads). Set it to about the total worker cores.
@@ -165,7 +168,7 @@ class CoordinatorService final : public v1::Coordinator::Service {
   std::unique_ptr<v1::Resample::Stub> resample_;
   std::unique_ptr<v1::Extract::Stub> extract_;
   std::unique_ptr<v1::Codebook::Stub> codebook_;
-  std::unique_ptr<v1::Index::Stub> index_;
+  std::unique_ptr<IndexShards> index_;
 
   absl::Mutex mutex_;
   std::unique_ptr<Database> db_ ABSL_GUARDED_BY(mutex_);

@@ -2,14 +2,26 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <tuple>
 
 #include "absl/strings/str_cat.h"
+#include "common/base/parallel.h"
 #include "common/base/status_macros.h"
-#include "common/pipeline/retrieval_pipeline.h"
 #include "common/rpc/convert.h"
 #include "common/rpc/status.h"
 
 namespace meshseek {
+namespace {
+
+grpc::Status InvalidArgument(const std::string& message) {
+  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, message);
+}
+
+double EpsilonOrDefault(double epsilon) {
+  return epsilon > 0 ? epsilon : KlDivergenceOptions().epsilon;
+}
+
+}  // namespace
 
 absl::Status IndexServiceOptions::Validate() const {
   if (data_dir.empty()) return absl::InvalidArgumentError("index: --data_dir is required");
@@ -33,25 +45,60 @@ absl::StatusOr<std::unique_ptr<IndexService>> IndexService::Create(
 }
 
 absl::Status IndexService::Load() {
+  absl::MutexLock write(&write_mutex_);
   absl::MutexLock lock(&mutex_);
   MESHSEEK_ASSIGN_OR_RETURN(
       Statement select,
       db_->Prepare("SELECT collection, model_id, ordinal, label, histogram FROM models"));
-  std::size_t loaded = 0;
   while (true) {
     MESHSEEK_ASSIGN_OR_RETURN(const bool row, select.Step());
     if (!row) break;
+    const std::string model_id = select.ColumnText(1);
     v1::SparseHistogram proto;
-    if (!proto.ParseFromString(select.ColumnBlob(4))) {
-      return absl::DataLossError(absl::StrCat("index: stored histogram of model '",
-                                              select.ColumnText(1), "' does not parse"));
+    absl::StatusOr<SparseHistogram> histogram =
+        proto.ParseFromString(select.ColumnBlob(4))
+            ? rpc::SparseHistogramFromProto(proto, absl::StrCat("model '", model_id, "'"))
+            : absl::InvalidArgumentError("does not parse");
+    absl::Status placed = histogram.status();
+    if (placed.ok()) {
+      placed = Place(&collections_[select.ColumnText(0)], model_id,
+                     static_cast<uint64_t>(select.ColumnInt(2)), select.ColumnText(3), *histogram);
     }
-    MESHSEEK_ASSIGN_OR_RETURN(std::vector<float> histogram, rpc::HistogramFromProto(proto));
-    Entry entry{select.ColumnText(1), static_cast<uint64_t>(select.ColumnInt(2)),
-                select.ColumnText(3), std::move(histogram), proto.size()};
-    collections_[select.ColumnText(0)][entry.model_id] = std::move(entry);
-    ++loaded;
+    if (!placed.ok()) {
+      return absl::DataLossError(absl::StrCat("index: stored histogram of model '", model_id,
+                                              "' in collection '", select.ColumnText(0),
+                                              "': ", placed.message()));
+    }
   }
+  return absl::OkStatus();
+}
+
+absl::Status IndexService::Place(Collection* collection,
+                                 const std::string& model_id,
+                                 uint64_t ordinal,
+                                 const std::string& label,
+                                 const SparseHistogram& histogram) {
+  if (!collection->engine.has_value() ||
+      (collection->engine->vocabulary() != histogram.vocabulary && collection->docs.size() == 1 &&
+       collection->docs.contains(model_id))) {
+    // The first model fixes the vocabulary (or the only one replaces itself).
+    KlDivergenceOptions kl;
+    if (collection->engine.has_value()) kl = collection->engine->options();
+    MESHSEEK_ASSIGN_OR_RETURN(KlInvertedIndex engine,
+                              KlInvertedIndex::Create(histogram.vocabulary, kl));
+    collection->engine = std::move(engine);
+    collection->docs.clear();
+    collection->models.clear();
+  }
+  if (collection->engine->vocabulary() != histogram.vocabulary) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("histogram of size ", histogram.vocabulary, " but the collection holds size ",
+                     collection->engine->vocabulary()));
+  }
+  auto [it, inserted] = collection->docs.try_emplace(model_id, collection->next_doc);
+  if (inserted) ++collection->next_doc;
+  MESHSEEK_RETURN_IF_ERROR(collection->engine->Upsert(it->second, histogram));
+  collection->models[it->second] = Model{model_id, ordinal, label};
   return absl::OkStatus();
 }
 
@@ -59,29 +106,23 @@ grpc::Status IndexService::AddModel(grpc::ServerContext*,
                                     const v1::AddModelRequest* request,
                                     v1::AddModelResponse* response) {
   if (request->collection().empty() || request->model_id().empty()) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                        "add: collection and model_id must not be empty");
+    return InvalidArgument("add: collection and model_id must not be empty");
   }
-  absl::StatusOr<std::vector<float>> histogram = rpc::HistogramFromProto(request->histogram());
-  if (!histogram.ok()) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                        absl::StrCat("add model '", request->model_id(),
-                                     "': ", histogram.status().message()));
-  }
-  absl::MutexLock lock(&mutex_);
-  auto& models = collections_[request->collection()];
-  // All histograms of a collection come from one codebook: refuse another size.
-  if (!histogram->empty()) {
-    for (const auto& [id, other] : models) {
-      if (id == request->model_id() || other.histogram.empty()) continue;
-      if (other.vocabulary != request->histogram().size()) {
-        return grpc::Status(
-            grpc::StatusCode::INVALID_ARGUMENT,
-            absl::StrCat("add model '", request->model_id(), "': histogram of size ",
-                         request->histogram().size(), " but collection '", request->collection(),
-                         "' holds size ", other.vocabulary, " (model '", id, "')"));
-      }
-      break;
+  const std::string name = absl::StrCat("add model '", request->model_id(), "'");
+  absl::StatusOr<SparseHistogram> histogram =
+      rpc::SparseHistogramFromProto(request->histogram(), name);
+  if (!histogram.ok()) return rpc::ToGrpcStatus(histogram.status());
+  absl::MutexLock write(&write_mutex_);
+  {
+    // Refuse what Place would refuse before anything is written.
+    absl::ReaderMutexLock lock(&mutex_);
+    auto it = collections_.find(request->collection());
+    if (it != collections_.end() && it->second.engine.has_value() &&
+        it->second.engine->vocabulary() != histogram->vocabulary &&
+        !(it->second.docs.size() == 1 && it->second.docs.contains(request->model_id()))) {
+      return InvalidArgument(absl::StrCat(name, ": histogram of size ", histogram->vocabulary,
+                                          " but collection '", request->collection(),
+                                          "' holds size ", it->second.engine->vocabulary()));
     }
   }
   absl::StatusOr<Statement> upsert = db_->Prepare(
@@ -95,101 +136,209 @@ grpc::Status IndexService::AddModel(grpc::ServerContext*,
                                           .Run()
                                     : upsert.status();
   if (!stored.ok()) return rpc::ToGrpcStatus(stored);
-  models[request->model_id()] = Entry{request->model_id(), request->ordinal(), request->label(),
-                                      *std::move(histogram), request->histogram().size()};
-  response->set_collection_size(models.size());
+  absl::MutexLock lock(&mutex_);
+  Collection& collection = collections_[request->collection()];
+  const absl::Status placed = Place(&collection, request->model_id(), request->ordinal(),
+                                    request->label(), *histogram);
+  if (!placed.ok()) return rpc::ToGrpcStatus(placed);  // checked above: not reached
+  response->set_collection_size(collection.docs.size());
   return grpc::Status::OK;
 }
 
 grpc::Status IndexService::RemoveModel(grpc::ServerContext*,
                                        const v1::RemoveModelRequest* request,
                                        v1::RemoveModelResponse* response) {
-  absl::MutexLock lock(&mutex_);
+  absl::MutexLock write(&write_mutex_);
   absl::StatusOr<Statement> remove =
       db_->Prepare("DELETE FROM models WHERE collection = ? AND model_id = ?");
   absl::Status done = remove.ok()
                           ? remove->Bind(1, request->collection()).Bind(2, request->model_id()).Run()
                           : remove.status();
   if (!done.ok()) return rpc::ToGrpcStatus(done);
+  absl::MutexLock lock(&mutex_);
   auto it = collections_.find(request->collection());
-  response->set_removed(it != collections_.end() && it->second.erase(request->model_id()) > 0);
+  bool removed = false;
+  if (it != collections_.end()) {
+    Collection& collection = it->second;
+    auto doc = collection.docs.find(request->model_id());
+    if (doc != collection.docs.end()) {
+      collection.engine->Remove(doc->second);
+      collection.models.erase(doc->second);
+      collection.docs.erase(doc);
+      removed = true;
+    }
+  }
+  response->set_removed(removed);
   return grpc::Status::OK;
 }
 
-absl::StatusOr<std::vector<IndexService::Entry>> IndexService::Snapshot(
-    const std::string& collection) {
-  absl::MutexLock lock(&mutex_);
-  auto it = collections_.find(collection);
-  if (it == collections_.end() || it->second.empty()) {
-    return absl::NotFoundError(absl::StrCat("index has no models in collection '", collection, "'"));
+void IndexService::UseEpsilon(const std::string& name, double epsilon) {
+  epsilon = EpsilonOrDefault(epsilon);
+  {
+    absl::ReaderMutexLock lock(&mutex_);
+    auto it = collections_.find(name);
+    if (it == collections_.end() || !it->second.engine.has_value() ||
+        it->second.engine->options().epsilon == epsilon) {
+      return;
+    }
   }
-  std::vector<Entry> entries;
-  entries.reserve(it->second.size());
-  for (const auto& [id, entry] : it->second) entries.push_back(entry);
-  std::stable_sort(entries.begin(), entries.end(),
-                   [](const Entry& a, const Entry& b) { return a.ordinal < b.ordinal; });
-  return entries;
+  absl::MutexLock lock(&mutex_);
+  auto it = collections_.find(name);
+  if (it == collections_.end() || !it->second.engine.has_value()) return;
+  const KlInvertedIndex& old = *it->second.engine;
+  if (old.options().epsilon == epsilon) return;
+  KlDivergenceOptions kl = old.options();
+  kl.epsilon = epsilon;
+  absl::StatusOr<KlInvertedIndex> rebuilt = KlInvertedIndex::Create(old.vocabulary(), kl);
+  if (!rebuilt.ok()) return;  // FindCollection reports the mismatch
+  absl::Status status;
+  old.ForEach([&](uint32_t doc, const SparseHistogram& histogram) {
+    if (status.ok()) status = rebuilt->Upsert(doc, histogram);
+  });
+  if (status.ok()) it->second.engine = *std::move(rebuilt);
+}
+
+absl::StatusOr<const IndexService::Collection*> IndexService::FindCollection(
+    const std::string& name, double epsilon) {
+  auto it = collections_.find(name);
+  if (it == collections_.end() || it->second.docs.empty()) {
+    return absl::NotFoundError(absl::StrCat("index has no models in collection '", name, "'"));
+  }
+  if (it->second.engine->options().epsilon != EpsilonOrDefault(epsilon)) {
+    return absl::AbortedError(absl::StrCat("collection '", name, "' is ranked with KL epsilon ",
+                                           it->second.engine->options().epsilon,
+                                           " (changed meanwhile); retry"));
+  }
+  return &it->second;
+}
+
+std::vector<uint32_t> IndexService::DocsInOrder(const Collection& collection) {
+  std::vector<uint32_t> docs;
+  docs.reserve(collection.models.size());
+  for (const auto& [doc, model] : collection.models) docs.push_back(doc);
+  std::sort(docs.begin(), docs.end(), [&](uint32_t a, uint32_t b) {
+    const Model& x = collection.models.at(a);
+    const Model& y = collection.models.at(b);
+    return std::tie(x.ordinal, x.model_id) < std::tie(y.ordinal, y.model_id);
+  });
+  return docs;
 }
 
 grpc::Status IndexService::Search(grpc::ServerContext*,
                                   const v1::SearchRequest* request,
                                   v1::SearchResponse* response) {
-  if (request->top_k() == 0) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "search: top_k must be at least 1");
-  }
-  absl::StatusOr<std::vector<float>> query = rpc::HistogramFromProto(request->histogram());
+  if (request->top_k() == 0) return InvalidArgument("search: top_k must be at least 1");
+  absl::StatusOr<SparseHistogram> query =
+      rpc::SparseHistogramFromProto(request->histogram(), "search: query histogram");
   if (!query.ok()) return rpc::ToGrpcStatus(query.status());
-  absl::StatusOr<std::vector<Entry>> entries = Snapshot(request->collection());
-  if (!entries.ok()) return rpc::ToGrpcStatus(entries.status());
-  std::vector<std::vector<float>> histograms;
-  for (const Entry& e : *entries) {
-    if (!query->empty() && !e.histogram.empty() && e.histogram.size() != query->size()) {
-      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                          absl::StrCat("search: query histogram has size ", query->size(),
-                                       ", the collection's have ", e.histogram.size()));
-    }
-    histograms.push_back(e.histogram);
-  }
-  RetrievalPipelineOptions options;
-  if (request->kl_epsilon() > 0) options.kl.epsilon = request->kl_epsilon();
-  options.num_threads = options_.num_threads;
-  absl::StatusOr<std::vector<float>> distances = QueryDistances(*query, histograms, options);
-  if (!distances.ok()) return rpc::ToGrpcStatus(distances.status());
-  std::vector<std::size_t> order(entries->size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return (*distances)[a] < (*distances)[b]; });
-  order.resize(std::min<std::size_t>(order.size(), request->top_k()));
-  for (std::size_t i : order) {
+  UseEpsilon(request->collection(), request->kl_epsilon());
+  absl::ReaderMutexLock lock(&mutex_);
+  absl::StatusOr<const Collection*> collection =
+      FindCollection(request->collection(), request->kl_epsilon());
+  if (!collection.ok()) return rpc::ToGrpcStatus(collection.status());
+  absl::StatusOr<std::vector<KlNeighbor>> found =
+      (*collection)->engine->Search(*query, request->top_k(), options_.num_threads);
+  if (!found.ok()) return rpc::ToGrpcStatus(found.status());
+  // The engine breaks ties by doc and returns every model tied with the k-th:
+  // rank ties by ordinal (then id) as the whole collection would be.
+  struct Hit {
+    float distance;
+    const Model* model;
+  };
+  std::vector<Hit> hits;
+  hits.reserve(found->size());
+  for (const KlNeighbor& nb : *found) hits.push_back({nb.distance, &(*collection)->models.at(nb.doc)});
+  std::sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) {
+    return std::tie(a.distance, a.model->ordinal, a.model->model_id) <
+           std::tie(b.distance, b.model->ordinal, b.model->model_id);
+  });
+  hits.resize(std::min<std::size_t>(hits.size(), request->top_k()));
+  for (const Hit& hit : hits) {
     v1::ScoredModel* result = response->add_results();
-    result->set_model_id((*entries)[i].model_id);
-    result->set_label((*entries)[i].label);
-    result->set_distance((*distances)[i]);
+    result->set_model_id(hit.model->model_id);
+    result->set_label(hit.model->label);
+    result->set_distance(hit.distance);
+    result->set_ordinal(hit.model->ordinal);
   }
   return grpc::Status::OK;
 }
 
-grpc::Status IndexService::DistanceMatrix(grpc::ServerContext* context,
-                                          const v1::DistanceMatrixRequest* request,
-                                          grpc::ServerWriter<v1::DistanceRow>* writer) {
-  absl::StatusOr<std::vector<Entry>> entries = Snapshot(request->collection());
-  if (!entries.ok()) return rpc::ToGrpcStatus(entries.status());
-  std::vector<std::vector<float>> histograms;
-  for (const Entry& e : *entries) histograms.push_back(e.histogram);
-  RetrievalPipelineOptions options;
-  if (request->kl_epsilon() > 0) options.kl.epsilon = request->kl_epsilon();
-  options.num_threads = options_.num_threads;
-  absl::StatusOr<std::vector<float>> matrix = RankCollection(histograms, options);
-  if (!matrix.ok()) return rpc::ToGrpcStatus(matrix.status());
-  const std::size_t n = entries->size();
-  v1::DistanceRow row;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (context->IsCancelled()) return grpc::Status::CANCELLED;
-    row.set_model_id((*entries)[i].model_id);
-    row.set_label((*entries)[i].label);
-    row.set_ordinal((*entries)[i].ordinal);
-    row.mutable_distances()->Assign(matrix->begin() + i * n, matrix->begin() + (i + 1) * n);
-    if (!writer->Write(row)) return grpc::Status::CANCELLED;
+grpc::Status IndexService::ExportModels(grpc::ServerContext* context,
+                                        const v1::ExportModelsRequest* request,
+                                        grpc::ServerWriter<v1::IndexedModel>* writer) {
+  // Copied under the lock, streamed after it: a slow reader never holds up
+  // writers. Meant for evaluation-sized collections.
+  std::vector<v1::IndexedModel> models;
+  {
+    absl::ReaderMutexLock lock(&mutex_);
+    auto it = collections_.find(request->collection());
+    if (it == collections_.end() || it->second.docs.empty()) {
+      return grpc::Status(
+          grpc::StatusCode::NOT_FOUND,
+          absl::StrCat("index has no models in collection '", request->collection(), "'"));
+    }
+    const Collection& collection = it->second;
+    const std::vector<uint32_t> docs = DocsInOrder(collection);
+    absl::flat_hash_map<uint32_t, std::size_t> position;
+    for (std::size_t i = 0; i < docs.size(); ++i) position[docs[i]] = i;
+    models.resize(docs.size());
+    collection.engine->ForEach([&](uint32_t doc, const SparseHistogram& histogram) {
+      v1::IndexedModel& out = models[position.at(doc)];
+      const Model& model = collection.models.at(doc);
+      out.set_model_id(model.model_id);
+      out.set_ordinal(model.ordinal);
+      out.set_label(model.label);
+      rpc::SparseHistogramToProto(histogram, out.mutable_histogram());
+    });
+  }
+  for (const v1::IndexedModel& model : models) {
+    if (context->IsCancelled() || !writer->Write(model)) return grpc::Status::CANCELLED;
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status IndexService::Distances(grpc::ServerContext*,
+                                     const v1::DistancesRequest* request,
+                                     v1::DistancesResponse* response) {
+  if (request->queries_size() > kMaxDistanceQueries) {
+    return InvalidArgument(absl::StrCat("distances: ", request->queries_size(),
+                                        " queries, at most ", kMaxDistanceQueries, " per request"));
+  }
+  std::vector<SparseHistogram> queries;
+  for (int q = 0; q < request->queries_size(); ++q) {
+    absl::StatusOr<SparseHistogram> query =
+        rpc::SparseHistogramFromProto(request->queries(q), absl::StrCat("distances: query ", q));
+    if (!query.ok()) return rpc::ToGrpcStatus(query.status());
+    queries.push_back(*std::move(query));
+  }
+  UseEpsilon(request->collection(), request->kl_epsilon());
+  absl::ReaderMutexLock lock(&mutex_);
+  absl::StatusOr<const Collection*> found =
+      FindCollection(request->collection(), request->kl_epsilon());
+  if (!found.ok()) return rpc::ToGrpcStatus(found.status());
+  const Collection& collection = **found;
+  const std::vector<uint32_t> docs = DocsInOrder(collection);
+  absl::flat_hash_map<uint32_t, std::size_t> column;
+  for (std::size_t i = 0; i < docs.size(); ++i) {
+    column[docs[i]] = i;
+    const Model& model = collection.models.at(docs[i]);
+    response->add_model_ids(model.model_id);
+    response->add_ordinals(model.ordinal);
+  }
+  const std::size_t n = docs.size();
+  response->mutable_distances()->Resize(static_cast<int>(queries.size() * n), 0.0f);
+  float* out = response->mutable_distances()->mutable_data();
+  std::vector<absl::Status> errors(queries.size());
+  ParallelFor(queries.size(), options_.num_threads, [&](std::size_t q) {
+    absl::StatusOr<std::vector<KlNeighbor>> row = collection.engine->Distances(queries[q], 1);
+    if (!row.ok()) {
+      errors[q] = row.status();
+      return;
+    }
+    for (const KlNeighbor& nb : *row) out[q * n + column.at(nb.doc)] = nb.distance;
+  });
+  for (const absl::Status& error : errors) {
+    if (!error.ok()) return rpc::ToGrpcStatus(error);
   }
   return grpc::Status::OK;
 }
@@ -197,14 +346,22 @@ grpc::Status IndexService::DistanceMatrix(grpc::ServerContext* context,
 grpc::Status IndexService::ListModels(grpc::ServerContext*,
                                       const v1::ListModelsRequest* request,
                                       v1::ListModelsResponse* response) {
-  absl::StatusOr<std::vector<Entry>> entries = Snapshot(request->collection());
-  if (!entries.ok()) {
-    return entries.status().code() == absl::StatusCode::kNotFound
-               ? grpc::Status::OK
-               : rpc::ToGrpcStatus(entries.status());
+  absl::ReaderMutexLock lock(&mutex_);
+  auto it = collections_.find(request->collection());
+  if (it == collections_.end()) return grpc::Status::OK;
+  for (uint32_t doc : DocsInOrder(it->second)) {
+    response->add_model_ids(it->second.models.at(doc).model_id);
   }
-  for (const Entry& e : *entries) response->add_model_ids(e.model_id);
   return grpc::Status::OK;
+}
+
+std::size_t IndexService::MemoryBytes() {
+  absl::ReaderMutexLock lock(&mutex_);
+  std::size_t bytes = 0;
+  for (const auto& [name, collection] : collections_) {
+    if (collection.engine.has_value()) bytes += collection.engine->MemoryBytes();
+  }
+  return bytes;
 }
 
 }  // namespace meshseek

@@ -1,21 +1,31 @@
 // The index service: per collection, each model's id, ordinal, label and
-// bag-of-features histogram, ranked by symmetric KL divergence
-// (QueryDistances / RankCollection, the in-process pipeline's code).
+// bag-of-features histogram, ranked by exact symmetric KL divergence through
+// an inverted file (common/search/kl_inverted_index.h): sparse storage, no
+// copy of the collection per query, and queries in parallel with each other
+// under a reader lock.
 //
 // Every add and remove is written to SQLite (WAL) before it is answered, and
 // the whole index is loaded into memory at start, so a kill -9 and restart
 // lose no acknowledged model. Adds are upserts by (collection, model id): a
 // retry never duplicates.
+//
+// One server may be one shard of a collection: the coordinator places each
+// model on a shard and merges what the shards answer (Search's top-k, and
+// ExportModels + Distances for the all-pairs matrix). A shard that holds no
+// model of a collection answers NOT_FOUND like an unknown collection.
 #ifndef MESHSEEK_SERVICES_INDEX_INDEX_SERVICE_H_
 #define MESHSEEK_SERVICES_INDEX_INDEX_SERVICE_H_
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
+#include "common/search/kl_inverted_index.h"
 #include "common/store/sqlite_db.h"
 #include "meshseek/v1/index.grpc.pb.h"
 
@@ -24,7 +34,8 @@ namespace meshseek {
 struct IndexServiceOptions {
   /// Folder of the database (index.db); created if missing.
   std::string data_dir;
-  /// Threads for ranking (<= 0: all cores). Results do not depend on it.
+  /// Threads for one search and for a batch of Distances (<= 0: all cores).
+  /// Results do not depend on it.
   int num_threads = 0;
 
   absl::Status Validate() const;
@@ -32,6 +43,9 @@ struct IndexServiceOptions {
 
 class IndexService final : public v1::Index::Service {
  public:
+  /// Most query histograms in one Distances request.
+  static constexpr int kMaxDistanceQueries = 4096;
+
   static absl::StatusOr<std::unique_ptr<IndexService>> Create(const IndexServiceOptions& options);
 
   grpc::Status AddModel(grpc::ServerContext* context,
@@ -43,32 +57,63 @@ class IndexService final : public v1::Index::Service {
   grpc::Status Search(grpc::ServerContext* context,
                       const v1::SearchRequest* request,
                       v1::SearchResponse* response) override;
-  grpc::Status DistanceMatrix(grpc::ServerContext* context,
-                              const v1::DistanceMatrixRequest* request,
-                              grpc::ServerWriter<v1::DistanceRow>* writer) override;
+  grpc::Status ExportModels(grpc::ServerContext* context,
+                            const v1::ExportModelsRequest* request,
+                            grpc::ServerWriter<v1::IndexedModel>* writer) override;
+  grpc::Status Distances(grpc::ServerContext* context,
+                         const v1::DistancesRequest* request,
+                         v1::DistancesResponse* response) override;
   grpc::Status ListModels(grpc::ServerContext* context,
                           const v1::ListModelsRequest* request,
                           v1::ListModelsResponse* response) override;
 
+  /// Bytes held by the in-memory index of every collection (for benchmarks).
+  std::size_t MemoryBytes();
+
  private:
-  struct Entry {
+  struct Model {
     std::string model_id;
     uint64_t ordinal = 0;
     std::string label;
-    std::vector<float> histogram;  // dense; empty = no features
-    uint32_t vocabulary = 0;
   };
+  struct Collection {
+    absl::flat_hash_map<std::string, uint32_t> docs;  // model id -> doc
+    absl::flat_hash_map<uint32_t, Model> models;      // doc -> model
+    uint32_t next_doc = 0;
+    // Created by the first add, with its vocabulary and the default epsilon;
+    // rebuilt when a request asks for another epsilon.
+    std::optional<KlInvertedIndex> engine;
+  };
+
   IndexService(const IndexServiceOptions& options, std::unique_ptr<Database> db)
       : options_(options), db_(std::move(db)) {}
   absl::Status Load();
-  // The collection's entries in ordinal order (ties by id), or NotFound.
-  absl::StatusOr<std::vector<Entry>> Snapshot(const std::string& collection);
+  // Puts one model into memory (after it is durable). Caller holds mutex_
+  // for writing.
+  absl::Status Place(Collection* collection,
+                     const std::string& model_id,
+                     uint64_t ordinal,
+                     const std::string& label,
+                     const SparseHistogram& histogram) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // Makes the engine of collection `name` use `epsilon` (0: the default),
+  // rebuilding it under the writer lock when it uses another (collections keep
+  // one epsilon, so this happens once, if ever).
+  void UseEpsilon(const std::string& name, double epsilon) ABSL_LOCKS_EXCLUDED(mutex_);
+  // The collection with an engine using `epsilon`; NotFound for an unknown or
+  // empty one, Aborted if another epsilon was asked for meanwhile.
+  absl::StatusOr<const Collection*> FindCollection(const std::string& name, double epsilon)
+      ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  // Docs in (ordinal, model id) order.
+  static std::vector<uint32_t> DocsInOrder(const Collection& collection);
 
   const IndexServiceOptions options_;
+  // Serialises writers: the database write and the in-memory update of one
+  // add happen in the same order for every writer.
+  absl::Mutex write_mutex_;
+  std::unique_ptr<Database> db_ ABSL_GUARDED_BY(write_mutex_);
+  // Readers (searches) share it; writers hold it only for the in-memory update.
   absl::Mutex mutex_;
-  std::unique_ptr<Database> db_ ABSL_GUARDED_BY(mutex_);
-  // collection -> model id -> entry.
-  std::map<std::string, std::map<std::string, Entry>> collections_ ABSL_GUARDED_BY(mutex_);
+  std::map<std::string, Collection> collections_ ABSL_GUARDED_BY(mutex_);
 };
 
 }  // namespace meshseek

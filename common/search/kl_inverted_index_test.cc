@@ -1,0 +1,267 @@
+#include "common/search/kl_inverted_index.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+
+#include "common/bof/kl_divergence.h"
+
+namespace meshseek {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Dense histograms with about `used` of `bins` words non-zero, shaped like
+// bag-of-features histograms: integer counts over a total, a few frequent
+// words and many rare ones.
+std::vector<std::vector<float>> CountHistograms(std::size_t count,
+                                                std::size_t bins,
+                                                std::size_t descriptors,
+                                                uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::vector<std::vector<float>> out(count, std::vector<float>(bins, 0.0f));
+  for (auto& h : out) {
+    // Each model prefers its own region of the vocabulary (Zipf-like).
+    const std::size_t centre = rng() % bins;
+    std::vector<uint32_t> counts(bins, 0);
+    for (std::size_t d = 0; d < descriptors; ++d) {
+      const double u = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+      const auto offset = static_cast<std::size_t>(std::pow(u, 3.0) * bins);
+      ++counts[(centre + offset) % bins];
+    }
+    for (std::size_t k = 0; k < bins; ++k) {
+      h[k] = static_cast<float>(counts[k]) / static_cast<float>(descriptors);
+    }
+  }
+  return out;
+}
+
+KlInvertedIndex MakeIndex(const std::vector<std::vector<float>>& dense,
+                          const KlDivergenceOptions& options = {}) {
+  absl::StatusOr<KlInvertedIndex> index =
+      KlInvertedIndex::Create(static_cast<uint32_t>(dense[0].size()), options);
+  EXPECT_TRUE(index.ok()) << index.status();
+  for (std::size_t i = 0; i < dense.size(); ++i) {
+    const absl::Status added = index->Upsert(static_cast<uint32_t>(i), SparseFromDense(dense[i]));
+    EXPECT_TRUE(added.ok()) << added;
+  }
+  return *std::move(index);
+}
+
+std::vector<float> ByDoc(const std::vector<KlNeighbor>& neighbors, std::size_t n) {
+  std::vector<float> out(n, -1.0f);
+  for (const KlNeighbor& nb : neighbors) out[nb.doc] = nb.distance;
+  return out;
+}
+
+// Ranking of row i of an n x n matrix: the others by (distance, index).
+std::vector<std::size_t> Ranking(const std::vector<float>& matrix, std::size_t n, std::size_t i) {
+  std::vector<std::size_t> order;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (j != i) order.push_back(j);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return matrix[i * n + a] < matrix[i * n + b];
+  });
+  return order;
+}
+
+TEST(KlInvertedIndexTest, EqualsThePairwiseCodeOnCountHistograms) {
+  for (const std::size_t bins : {50u, 2000u}) {
+    const auto dense = CountHistograms(120, bins, 2500, 7);
+    const KlInvertedIndex index = MakeIndex(dense);
+    std::vector<uint32_t> docs(dense.size());
+    std::iota(docs.begin(), docs.end(), 0u);
+    const absl::StatusOr<std::vector<float>> fast = index.DistanceMatrix(docs, 2);
+    ASSERT_TRUE(fast.ok()) << fast.status();
+    const absl::StatusOr<std::vector<float>> reference = SymmetricKlDistanceMatrix(dense, {}, 2);
+    ASSERT_TRUE(reference.ok());
+    const std::size_t n = dense.size();
+    for (std::size_t i = 0; i < n * n; ++i) {
+      EXPECT_NEAR((*fast)[i], (*reference)[i], 1e-5 * (*reference)[i] + 1e-6) << "entry " << i;
+    }
+    std::size_t identical_rankings = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      identical_rankings += Ranking(*fast, n, i) == Ranking(*reference, n, i);
+    }
+    EXPECT_EQ(identical_rankings, n) << "bins " << bins;
+  }
+}
+
+TEST(KlInvertedIndexTest, EqualsThePairwiseCodeOnSmoothRandomHistograms) {
+  // Non-count weights, a sum that is 1 only within float rounding, and
+  // another epsilon.
+  std::mt19937 rng(3);
+  std::vector<std::vector<float>> dense(40, std::vector<float>(300));
+  for (auto& h : dense) {
+    double sum = 0.0;
+    std::vector<double> raw(h.size());
+    for (double& v : raw) {
+      sum += v = std::uniform_real_distribution<double>(0, 1)(rng) < 0.6
+                     ? 0.0
+                     : std::uniform_real_distribution<double>(0, 1)(rng);
+    }
+    for (std::size_t k = 0; k < h.size(); ++k) h[k] = static_cast<float>(raw[k] / sum);
+  }
+  KlDivergenceOptions options;
+  options.epsilon = 1e-6;
+  const KlInvertedIndex index = MakeIndex(dense, options);
+  for (std::size_t q = 0; q < dense.size(); q += 7) {
+    const auto fast = index.Distances(SparseFromDense(dense[q]), 1);
+    ASSERT_TRUE(fast.ok());
+    const auto reference = SymmetricKlDistances(dense[q], dense, options, 1);
+    ASSERT_TRUE(reference.ok());
+    const std::vector<float> by_doc = ByDoc(*fast, dense.size());
+    for (std::size_t j = 0; j < dense.size(); ++j) {
+      EXPECT_NEAR(by_doc[j], (*reference)[j], 1e-5 * (*reference)[j] + 1e-6);
+    }
+  }
+}
+
+TEST(KlInvertedIndexTest, MatrixIsExactlySymmetricAndEqualsQueriesBitForBit) {
+  const auto dense = CountHistograms(60, 400, 800, 11);
+  const KlInvertedIndex index = MakeIndex(dense);
+  std::vector<uint32_t> docs(dense.size());
+  std::iota(docs.begin(), docs.end(), 0u);
+  const auto matrix = index.DistanceMatrix(docs, 2);
+  ASSERT_TRUE(matrix.ok());
+  const std::size_t n = dense.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_EQ((*matrix)[i * n + i], 0.0f);
+    for (std::size_t j = 0; j < n; ++j) EXPECT_EQ((*matrix)[i * n + j], (*matrix)[j * n + i]);
+    const auto row = index.Distances(SparseFromDense(dense[i]), 1);
+    ASSERT_TRUE(row.ok());
+    const std::vector<float> by_doc = ByDoc(*row, n);
+    for (std::size_t j = 0; j < n; ++j) EXPECT_EQ(by_doc[j], (*matrix)[i * n + j]);
+    // A model as its own query: exactly 0.
+    EXPECT_EQ(by_doc[i], 0.0f);
+  }
+}
+
+TEST(KlInvertedIndexTest, ResultsDoNotDependOnThreadsOrSegments) {
+  // More models than one segment holds, so queries span two segments.
+  const std::size_t n = KlInvertedIndex::kSegmentSlots + 300;
+  const auto dense = CountHistograms(n, 64, 60, 5);
+  const KlInvertedIndex index = MakeIndex(dense);
+  EXPECT_EQ(index.size(), n);
+  const SparseHistogram query = SparseFromDense(dense[17]);
+  const auto one = index.Distances(query, 1);
+  const auto two = index.Distances(query, 2);
+  ASSERT_TRUE(one.ok() && two.ok());
+  EXPECT_EQ(ByDoc(*one, n), ByDoc(*two, n));
+  const auto reference = SymmetricKlDistances(dense[17], dense, {}, 2);
+  ASSERT_TRUE(reference.ok());
+  const std::vector<float> by_doc = ByDoc(*one, n);
+  for (std::size_t j = 0; j < n; j += 97) {
+    EXPECT_NEAR(by_doc[j], (*reference)[j], 1e-5 * (*reference)[j] + 1e-6);
+  }
+}
+
+TEST(KlInvertedIndexTest, SearchReturnsTheNearestWithTies) {
+  std::vector<std::vector<float>> dense = CountHistograms(30, 100, 500, 2);
+  dense[20] = dense[3];  // an exact duplicate: tied with 3 for any query
+  const KlInvertedIndex index = MakeIndex(dense);
+  const SparseHistogram query = SparseFromDense(dense[3]);
+  const auto all = index.Distances(query, 1);
+  ASSERT_TRUE(all.ok());
+  std::vector<KlNeighbor> sorted = *all;
+  std::sort(sorted.begin(), sorted.end(), [](const KlNeighbor& a, const KlNeighbor& b) {
+    return a.distance < b.distance || (a.distance == b.distance && a.doc < b.doc);
+  });
+  const auto top = index.Search(query, 1, 1);
+  ASSERT_TRUE(top.ok());
+  // Models 3 and 20 are both at distance 0: the tie comes back too.
+  ASSERT_EQ(top->size(), 2u);
+  EXPECT_EQ((*top)[0].doc, 3u);
+  EXPECT_EQ((*top)[1].doc, 20u);
+  EXPECT_EQ((*top)[1].distance, 0.0f);
+  const auto top5 = index.Search(query, 5, 2);
+  ASSERT_TRUE(top5.ok());
+  ASSERT_EQ(top5->size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i) {
+    EXPECT_EQ((*top5)[i].doc, sorted[i].doc);
+    EXPECT_EQ((*top5)[i].distance, sorted[i].distance);
+  }
+  EXPECT_EQ(index.Search(query, 100, 1)->size(), 30u);
+  EXPECT_THAT(std::string(index.Search(query, 0, 1).status().message()), HasSubstr("k must be"));
+}
+
+TEST(KlInvertedIndexTest, UpsertReplacesAndRemoveCompacts) {
+  const auto dense = CountHistograms(40, 80, 300, 9);
+  KlInvertedIndex index = MakeIndex(dense);
+  // Replace model 5 by model 6's histogram: it becomes 6's twin.
+  ASSERT_TRUE(index.Upsert(5, SparseFromDense(dense[6])).ok());
+  EXPECT_EQ(index.size(), 40u);
+  const auto twin = index.Distances(SparseFromDense(dense[6]), 1);
+  EXPECT_EQ(ByDoc(*twin, 40)[5], 0.0f);
+  // Removing most models rewrites the segment; the rest are unchanged.
+  const auto before = index.Distances(SparseFromDense(dense[1]), 1);
+  for (uint32_t doc = 10; doc < 40; ++doc) EXPECT_TRUE(index.Remove(doc));
+  EXPECT_FALSE(index.Remove(10));
+  EXPECT_EQ(index.size(), 10u);
+  EXPECT_FALSE(index.Contains(10));
+  const auto after = index.Distances(SparseFromDense(dense[1]), 1);
+  ASSERT_EQ(after->size(), 10u);
+  const std::vector<float> was = ByDoc(*before, 40);
+  for (const KlNeighbor& nb : *after) EXPECT_EQ(nb.distance, was[nb.doc]) << nb.doc;
+  // Histograms read back are the ones stored.
+  const auto stored = index.Histogram(7);
+  ASSERT_TRUE(stored.ok());
+  EXPECT_EQ(DenseFromSparse(*stored), dense[7]);
+  EXPECT_EQ(index.Histogram(30).status().code(), absl::StatusCode::kNotFound);
+  std::size_t visited = 0;
+  index.ForEach([&](uint32_t doc, const SparseHistogram& h) {
+    ++visited;
+    EXPECT_EQ(DenseFromSparse(h), doc == 5 ? dense[6] : dense[doc]) << doc;
+  });
+  EXPECT_EQ(visited, 10u);
+}
+
+TEST(KlInvertedIndexTest, ModelsWithoutFeaturesAreInfinitelyFar) {
+  auto dense = CountHistograms(5, 20, 100, 4);
+  KlInvertedIndex index = MakeIndex(dense);
+  SparseHistogram empty;
+  empty.vocabulary = 20;
+  ASSERT_TRUE(index.Upsert(9, empty).ok());
+  const auto from_model = index.Distances(SparseFromDense(dense[0]), 1);
+  for (const KlNeighbor& nb : *from_model) {
+    if (nb.doc == 9) {
+      EXPECT_EQ(nb.distance, kInf);
+    }
+  }
+  const auto from_empty = index.Distances(empty, 1);
+  for (const KlNeighbor& nb : *from_empty) EXPECT_EQ(nb.distance, kInf);
+  const auto matrix = index.DistanceMatrix({0, 9, 1}, 1);
+  ASSERT_TRUE(matrix.ok());
+  EXPECT_THAT(*matrix, ::testing::ElementsAre(0.0f, kInf, (*matrix)[2], kInf, 0.0f, kInf,
+                                              (*matrix)[2], kInf, 0.0f));
+}
+
+TEST(KlInvertedIndexTest, RejectsBadInputAndLeavesTheIndexUnchanged) {
+  EXPECT_FALSE(KlInvertedIndex::Create(0).ok());
+  KlDivergenceOptions bad;
+  bad.epsilon = 0;
+  EXPECT_FALSE(KlInvertedIndex::Create(10, bad).ok());
+  auto index = KlInvertedIndex::Create(10);
+  ASSERT_TRUE(index.ok());
+  ASSERT_TRUE(index->Upsert(1, {10, {2}, {1.0f}}).ok());
+  const absl::Status wrong_size = index->Upsert(1, {12, {2}, {1.0f}});
+  EXPECT_THAT(std::string(wrong_size.message()), HasSubstr("model 1 has vocabulary 12"));
+  const absl::Status not_normalised = index->Upsert(1, {10, {2, 3}, {0.5f, 0.2f}});
+  EXPECT_THAT(std::string(not_normalised.message()), HasSubstr("model 1 sums to 0.7"));
+  EXPECT_EQ(index->size(), 1u);
+  EXPECT_EQ(DenseFromSparse(*index->Histogram(1))[2], 1.0f);
+  EXPECT_THAT(std::string(index->Distances({10, {11}, {1.0f}}, 1).status().message()),
+              HasSubstr("query, entry 0: word 11"));
+  EXPECT_EQ(index->DistanceMatrix({1, 2}, 1).status().code(), absl::StatusCode::kNotFound);
+}
+
+}  // namespace
+}  // namespace meshseek

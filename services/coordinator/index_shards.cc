@@ -1,0 +1,193 @@
+#include "services/coordinator/index_shards.h"
+
+#include <algorithm>
+#include <tuple>
+
+#include "absl/container/flat_hash_map.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "common/base/hash.h"
+#include "common/base/parallel.h"
+#include "common/base/status_macros.h"
+
+namespace meshseek {
+namespace {
+
+bool Before(const v1::IndexedModel& a, const v1::IndexedModel& b) {
+  return std::make_tuple(a.ordinal(), std::cref(a.model_id())) <
+         std::make_tuple(b.ordinal(), std::cref(b.model_id()));
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<std::string>> IndexShards::ParseTargets(const std::string& targets) {
+  std::vector<std::string> out = absl::StrSplit(targets, ',');
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (out[i].empty()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("index shard ", i, " of '", targets, "' has an empty target"));
+    }
+  }
+  return out;
+}
+
+IndexShards::IndexShards(const std::vector<std::string>& targets,
+                         const rpc::ChannelOptions& channel,
+                         absl::Duration call_deadline,
+                         const rpc::RetryOptions& retry,
+                         const std::atomic<bool>* stop)
+    : call_deadline_(call_deadline), retry_(retry), stop_(stop) {
+  rpc::ChannelOptions options = channel;
+  options.retry_service = "meshseek.v1.Index";
+  for (const std::string& target : targets) {
+    shards_.push_back(v1::Index::NewStub(rpc::MakeChannel(target, options)));
+  }
+}
+
+std::size_t IndexShards::ShardOf(const std::string& model_id) const {
+  return Fnv1a64(model_id) % shards_.size();
+}
+
+absl::Status IndexShards::Add(const v1::AddModelRequest& request) {
+  v1::AddModelResponse response;
+  return rpc::CallWithRetry(shards_[ShardOf(request.model_id())].get(),
+                            &v1::Index::Stub::AddModel, request, &response, call_deadline_,
+                            retry_, stop_);
+}
+
+absl::StatusOr<bool> IndexShards::Remove(const std::string& collection,
+                                         const std::string& model_id) {
+  v1::RemoveModelRequest request;
+  request.set_collection(collection);
+  request.set_model_id(model_id);
+  v1::RemoveModelResponse response;
+  MESHSEEK_RETURN_IF_ERROR(rpc::CallWithRetry(shards_[ShardOf(model_id)].get(),
+                                              &v1::Index::Stub::RemoveModel, request, &response,
+                                              call_deadline_, retry_, stop_));
+  return response.removed();
+}
+
+absl::StatusOr<std::vector<v1::ScoredModel>> IndexShards::Search(const v1::SearchRequest& request) {
+  std::vector<v1::SearchResponse> answers(shards_.size());
+  std::vector<absl::Status> errors(shards_.size());
+  ParallelFor(shards_.size(), static_cast<int>(shards_.size()), [&](std::size_t s) {
+    errors[s] = rpc::CallWithRetry(shards_[s].get(), &v1::Index::Stub::Search, request, &answers[s],
+                                   call_deadline_, retry_, stop_);
+  });
+  std::vector<v1::ScoredModel> merged;
+  std::size_t not_found = 0;
+  for (std::size_t s = 0; s < shards_.size(); ++s) {
+    if (errors[s].code() == absl::StatusCode::kNotFound) {
+      ++not_found;
+      continue;
+    }
+    if (!errors[s].ok()) {
+      return absl::Status(errors[s].code(),
+                          absl::StrCat("index shard ", s, ": ", errors[s].message()));
+    }
+    for (v1::ScoredModel& m : *answers[s].mutable_results()) merged.push_back(std::move(m));
+  }
+  if (not_found == shards_.size()) return errors[0];
+  std::sort(merged.begin(), merged.end(), [](const v1::ScoredModel& a, const v1::ScoredModel& b) {
+    return std::make_tuple(a.distance(), a.ordinal(), std::cref(a.model_id())) <
+           std::make_tuple(b.distance(), b.ordinal(), std::cref(b.model_id()));
+  });
+  if (merged.size() > request.top_k()) merged.resize(request.top_k());
+  return merged;
+}
+
+absl::StatusOr<std::vector<v1::IndexedModel>> IndexShards::Export(std::size_t s,
+                                                                  const std::string& collection) {
+  std::vector<v1::IndexedModel> models;
+  v1::ExportModelsRequest request;
+  request.set_collection(collection);
+  const absl::Status status = rpc::RetryTransient(
+      [&]() -> absl::Status {
+        models.clear();
+        grpc::ClientContext context;
+        rpc::SetDeadline(&context, call_deadline_);
+        auto reader = shards_[s]->ExportModels(&context, request);
+        v1::IndexedModel model;
+        while (reader->Read(&model)) models.push_back(std::move(model));
+        const grpc::Status done = reader->Finish();
+        return absl::Status(static_cast<absl::StatusCode>(done.error_code()),
+                            done.error_message());
+      },
+      retry_, stop_);
+  if (status.code() == absl::StatusCode::kNotFound) return std::vector<v1::IndexedModel>();
+  if (!status.ok()) {
+    return absl::Status(status.code(), absl::StrCat("index shard ", s, ": ", status.message()));
+  }
+  return models;
+}
+
+absl::Status IndexShards::ForEachDistanceRow(const std::string& collection,
+                                             double kl_epsilon,
+                                             const std::function<absl::Status(const Row&)>& fn) {
+  // 1. Every model, from every shard, in (ordinal, id) order.
+  std::vector<v1::IndexedModel> models;
+  for (std::size_t s = 0; s < shards_.size(); ++s) {
+    MESHSEEK_ASSIGN_OR_RETURN(std::vector<v1::IndexedModel> part, Export(s, collection));
+    for (v1::IndexedModel& m : part) models.push_back(std::move(m));
+  }
+  if (models.empty()) {
+    return absl::NotFoundError(absl::StrCat("index has no models in collection '", collection, "'"));
+  }
+  std::sort(models.begin(), models.end(), Before);
+  const std::size_t n = models.size();
+  absl::flat_hash_map<std::string, std::size_t> column;
+  for (std::size_t i = 0; i < n; ++i) column[models[i].model_id()] = i;
+
+  // 2. Blocks of rows: each shard gives the distances from the block's
+  //    histograms to its own models, placed into their columns.
+  std::vector<float> block;
+  for (std::size_t begin = 0; begin < n; begin += kMatrixBatch) {
+    const std::size_t end = std::min(n, begin + kMatrixBatch);
+    v1::DistancesRequest request;
+    request.set_collection(collection);
+    request.set_kl_epsilon(kl_epsilon);
+    for (std::size_t i = begin; i < end; ++i) *request.add_queries() = models[i].histogram();
+    block.assign((end - begin) * n, -1.0f);
+    std::size_t covered = 0;
+    for (std::size_t s = 0; s < shards_.size(); ++s) {
+      v1::DistancesResponse response;
+      const absl::Status status =
+          rpc::CallWithRetry(shards_[s].get(), &v1::Index::Stub::Distances, request, &response,
+                             call_deadline_, retry_, stop_);
+      if (status.code() == absl::StatusCode::kNotFound) continue;
+      if (!status.ok()) {
+        return absl::Status(status.code(), absl::StrCat("index shard ", s, ": ", status.message()));
+      }
+      const std::size_t m = static_cast<std::size_t>(response.model_ids_size());
+      if (static_cast<std::size_t>(response.distances_size()) != (end - begin) * m) {
+        return absl::InternalError(absl::StrCat("index shard ", s, " answered ",
+                                                response.distances_size(), " distances for ",
+                                                end - begin, " queries and ", m, " models"));
+      }
+      for (std::size_t j = 0; j < m; ++j) {
+        auto it = column.find(response.model_ids(static_cast<int>(j)));
+        // A model added after the export has no row: it waits for the next
+        // evaluation.
+        if (it == column.end()) continue;
+        ++covered;
+        for (std::size_t q = 0; q < end - begin; ++q) {
+          block[q * n + it->second] = response.distances(static_cast<int>(q * m + j));
+        }
+      }
+    }
+    if (covered != n) {
+      // A model removed (or a shard emptied) between the export and now.
+      return absl::AbortedError(absl::StrCat("collection '", collection, "' changed while its ",
+                                             "distance matrix was assembled (", covered, " of ", n,
+                                             " models answered); try again"));
+    }
+    for (std::size_t i = begin; i < end; ++i) {
+      float* row = &block[(i - begin) * n];
+      row[i] = 0.0f;
+      MESHSEEK_RETURN_IF_ERROR(fn(Row{&models[i], absl::MakeConstSpan(row, n)}));
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace meshseek

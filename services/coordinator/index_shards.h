@@ -1,0 +1,85 @@
+// The coordinator's view of the index: one or more index servers (shards),
+// each model on exactly one of them, chosen by a stable hash of its id
+// (FNV-1a 64 modulo the number of shards), so any coordinator finds it again
+// without a table. Queries are scattered to every shard and their top-k
+// merged; the all-pairs matrix is assembled from each shard's models and
+// Distances blocks. Both are exact: distances are absolute, not relative to a
+// shard.
+//
+// No partial answers: every shard must answer (after the usual retries of
+// transient failures) or the whole call fails with that shard's status. A
+// shard that holds no model of the collection answers NOT_FOUND, which counts
+// as an empty part; NOT_FOUND from every shard is NOT_FOUND.
+//
+// The number of shards is fixed for a deployment: changing it would move
+// models to other shards (the coordinator records it and refuses another).
+#ifndef MESHSEEK_SERVICES_COORDINATOR_INDEX_SHARDS_H_
+#define MESHSEEK_SERVICES_COORDINATOR_INDEX_SHARDS_H_
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "absl/types/span.h"
+#include "common/rpc/client.h"
+#include "meshseek/v1/index.grpc.pb.h"
+
+namespace meshseek {
+
+class IndexShards {
+ public:
+  /// Query histograms per Distances request while assembling a matrix.
+  static constexpr int kMatrixBatch = 256;
+
+  /// `targets`: one gRPC target per shard, separated by commas (a shard is
+  /// one stateful server, so a comma never lists replicas here).
+  /// InvalidArgument for an empty list or an empty target.
+  static absl::StatusOr<std::vector<std::string>> ParseTargets(const std::string& targets);
+
+  IndexShards(const std::vector<std::string>& targets,
+              const rpc::ChannelOptions& channel,
+              absl::Duration call_deadline,
+              const rpc::RetryOptions& retry,
+              const std::atomic<bool>* stop);
+
+  std::size_t size() const { return shards_.size(); }
+  /// The shard that holds `model_id`.
+  std::size_t ShardOf(const std::string& model_id) const;
+
+  /// Upsert on the model's shard.
+  absl::Status Add(const v1::AddModelRequest& request);
+  /// Removal on the model's shard.
+  absl::StatusOr<bool> Remove(const std::string& collection, const std::string& model_id);
+  /// The top_k nearest over every shard, ties by ordinal then id.
+  absl::StatusOr<std::vector<v1::ScoredModel>> Search(const v1::SearchRequest& request);
+
+  /// One row of the all-pairs matrix.
+  struct Row {
+    const v1::IndexedModel* model;
+    absl::Span<const float> distances;  // to every model, in row order
+  };
+  /// Calls fn for each model of the collection in (ordinal, id) order with
+  /// its distances to every model in the same order (0 to itself). Returns
+  /// early with fn's first error. NOT_FOUND when no shard has the collection.
+  absl::Status ForEachDistanceRow(const std::string& collection,
+                                  double kl_epsilon,
+                                  const std::function<absl::Status(const Row&)>& fn);
+
+ private:
+  // Every model of `collection` on shard s (empty when it has none).
+  absl::StatusOr<std::vector<v1::IndexedModel>> Export(std::size_t s,
+                                                       const std::string& collection);
+
+  std::vector<std::unique_ptr<v1::Index::Stub>> shards_;
+  const absl::Duration call_deadline_;
+  const rpc::RetryOptions retry_;
+  const std::atomic<bool>* stop_;
+};
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_SERVICES_COORDINATOR_INDEX_SHARDS_H_
