@@ -18,7 +18,22 @@ absl::Status DepthImageOptions::Validate() const {
 DepthImageRenderer::DepthImageRenderer(const TriangleMesh& mesh,
                                        const TriangleBvh& bvh,
                                        const DepthImageOptions& options)
-    : mesh_(mesh), bvh_(bvh), options_(options), projected_(mesh.vertices.size()) {}
+    : mesh_(mesh), bvh_(bvh), options_(options) {
+  // Vertices relative to the centre of the model's bounding box, so that the
+  // projection can run in float even for a model far from the origin: the
+  // rounding error is then relative to the model's size, not its position
+  // (about 1e-7 of it, a ten-thousandth of a pixel at E = 0.2).
+  Vec3d lo(1e300, 1e300, 1e300), hi(-1e300, -1e300, -1e300);
+  for (const Vec3f& v : mesh.vertices) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], static_cast<double>(v[k]));
+      hi[k] = std::max(hi[k], static_cast<double>(v[k]));
+    }
+  }
+  origin_ = mesh.vertices.empty() ? Vec3d() : (lo + hi) * 0.5;
+  centred_.reserve(mesh.vertices.size());
+  for (const Vec3f& v : mesh.vertices) centred_.push_back(Vec3f(Vec3d(v) - origin_));
+}
 
 void DepthImageRenderer::RenderPair(const ViewFrame& frame, DepthImage* front, DepthImage* back) {
   const int size = options_.image_size;
@@ -33,60 +48,100 @@ void DepthImageRenderer::RenderPair(const ViewFrame& frame, DepthImage* front, D
   candidates_.clear();
   bvh_.Query(cube, &candidates_);
 
-  // Pixel coordinates: pixel centre (col, row) at px = col, py = row. The
-  // projection is done in double (models may sit far from the origin), the
-  // per-pixel work in float (image-sized numbers).
+  // Pixel coordinates: pixel centre (col, row) at px = col, py = row; h is
+  // the height along the normal. Each is an affine function of the centred
+  // vertex position, set up in double and evaluated in float (image-sized
+  // numbers).
   const double to_pixel = size / (2 * s);
-  if (++current_stamp_ == 0) {  // wrapped: reset the cache marks
-    for (Projected& p : projected_) p.stamp = 0;
-    current_stamp_ = 1;
-  }
+  const Vec3d p = frame.point - origin_;
+  const Vec3f to_px(right * to_pixel), to_py(up * -to_pixel), to_h(normal);
+  const float px0 = static_cast<float>((s - Dot(p, right)) * to_pixel - 0.5);
+  const float py0 = static_cast<float>((s + Dot(p, up)) * to_pixel - 0.5);
+  const float h0 = static_cast<float>(-Dot(p, normal));
+  // Per block of candidates: first project the corners and keep the
+  // triangles whose bounding box holds a pixel centre and whose height range
+  // meets the cube, then test the pixel centres of the kept ones. Most
+  // candidates of a dense mesh fail (triangles smaller than pixels, or
+  // outside the cube), unpredictably, so the first step has no branches: the
+  // corners are gathered into one column per coordinate, projected and tested
+  // by a loop the compiler vectorises (local arrays cannot alias), and the
+  // kept ones listed.
   const float sf = static_cast<float>(s);
   const float last = static_cast<float>(size - 1);
-  for (const uint32_t t : candidates_) {
-    const Projected* corner[3];
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t v = mesh_.triangles[t][k];
-      Projected& proj = projected_[v];
-      if (proj.stamp != current_stamp_) {
-        proj.stamp = current_stamp_;
-        const Vec3d d = Vec3d(mesh_.vertices[v]) - frame.point;
-        proj.px = static_cast<float>((Dot(d, right) + s) * to_pixel - 0.5);
-        proj.py = static_cast<float>((s - Dot(d, up)) * to_pixel - 0.5);
-        proj.h = static_cast<float>(Dot(d, normal));
+  const float beyond = static_cast<float>(size);
+  constexpr int kBlock = 64;
+  for (std::size_t start = 0; start < candidates_.size(); start += kBlock) {
+    const int m = static_cast<int>(std::min<std::size_t>(kBlock, candidates_.size() - start));
+    float corner[9][kBlock];  // x, y, z of corner 0, then 1, then 2
+    for (int j = 0; j < m; ++j) {
+      const Triangle& t = mesh_.triangles[candidates_[start + j]];
+      for (int k = 0; k < 3; ++k) {
+        const Vec3f& c = centred_[t[k]];
+        corner[3 * k][j] = c.x;
+        corner[3 * k + 1][j] = c.y;
+        corner[3 * k + 2][j] = c.z;
       }
-      corner[k] = &proj;
     }
-    const Projected &a = *corner[0], &b = *corner[1], &c = *corner[2];
-    if ((a.h > sf && b.h > sf && c.h > sf) || (a.h < -sf && b.h < -sf && c.h < -sf)) continue;
-    // Pixel centres inside the triangle's bounding box; most triangles of a
-    // dense mesh cover none and stop here.
-    const float min_x = std::max(0.0f, std::ceil(std::min({a.px, b.px, c.px})));
-    const float max_x = std::min(last, std::floor(std::max({a.px, b.px, c.px})));
-    if (min_x > max_x) continue;
-    const float min_y = std::max(0.0f, std::ceil(std::min({a.py, b.py, c.py})));
-    const float max_y = std::min(last, std::floor(std::max({a.py, b.py, c.py})));
-    if (min_y > max_y) continue;
-    const float area = (b.px - a.px) * (c.py - a.py) - (c.px - a.px) * (b.py - a.py);
-    if (std::abs(area) < 1e-9f) continue;  // seen edge-on
-    const float inv_area = 1.0f / area;
-    const int c0 = static_cast<int>(min_x), c1 = static_cast<int>(max_x);
-    const int r0 = static_cast<int>(min_y), r1 = static_cast<int>(max_y);
-    for (int row = r0; row <= r1; ++row) {
-      const float y = static_cast<float>(row);
-      for (int col = c0; col <= c1; ++col) {
-        const float x = static_cast<float>(col);
-        // Barycentric weights from edge functions; inclusive of edges.
-        const float w0 = ((b.px - x) * (c.py - y) - (c.px - x) * (b.py - y)) * inv_area;
-        const float w1 = ((c.px - x) * (a.py - y) - (a.px - x) * (c.py - y)) * inv_area;
-        const float w2 = 1.0f - w0 - w1;
-        constexpr float kEdgeEps = -1e-6f;
-        if (w0 < kEdgeEps || w1 < kEdgeEps || w2 < kEdgeEps) continue;
-        const float height = w0 * a.h + w1 * b.h + w2 * c.h;
-        if (height > sf || height < -sf) continue;
-        const std::size_t i = static_cast<std::size_t>(row) * size + col;
-        highest_[i] = std::max(highest_[i], height);
-        lowest_[i] = std::min(lowest_[i], height);
+    float view[9][kBlock];  // column, row, height of corner 0, then 1, then 2
+    int bounds[4][kBlock];  // first and last column, first and last row
+    int keep[kBlock];
+    for (int j = 0; j < m; ++j) {
+      float x[3], y[3], h[3];
+      for (int k = 0; k < 3; ++k) {
+        const float cx = corner[3 * k][j], cy = corner[3 * k + 1][j], cz = corner[3 * k + 2][j];
+        view[3 * k][j] = x[k] = px0 + to_px.x * cx + to_px.y * cy + to_px.z * cz;
+        view[3 * k + 1][j] = y[k] = py0 + to_py.x * cx + to_py.y * cy + to_py.z * cz;
+        view[3 * k + 2][j] = h[k] = h0 + to_h.x * cx + to_h.y * cy + to_h.z * cz;
+      }
+      // Clamped to [0, I] and [-1, I - 1] (vertices are finite: ValidateMesh)
+      // so that truncation gives ceilings and floors: the first column is
+      // I - floor(I - min_x), the last trunc(max_x), which is one too high
+      // only for max_x in (-1, 0) (a triangle then tested in vain; the exact
+      // floor defeats the vectoriser).
+      const float min_x = std::min(std::max(std::min(std::min(x[0], x[1]), x[2]), 0.0f), beyond);
+      const float max_x = std::max(std::min(std::max(std::max(x[0], x[1]), x[2]), last), -1.0f);
+      const float min_y = std::min(std::max(std::min(std::min(y[0], y[1]), y[2]), 0.0f), beyond);
+      const float max_y = std::max(std::min(std::max(std::max(y[0], y[1]), y[2]), last), -1.0f);
+      const float min_h = std::min(std::min(h[0], h[1]), h[2]);
+      const float max_h = std::max(std::max(h[0], h[1]), h[2]);
+      bounds[0][j] = size - static_cast<int>(beyond - min_x);
+      bounds[1][j] = static_cast<int>(max_x);
+      bounds[2][j] = size - static_cast<int>(beyond - min_y);
+      bounds[3][j] = static_cast<int>(max_y);
+      keep[j] = (bounds[0][j] <= bounds[1][j]) & (bounds[2][j] <= bounds[3][j]) & (min_h <= sf) &
+                (max_h >= -sf);
+    }
+    int kept[kBlock];
+    int num_kept = 0;
+    for (int j = 0; j < m; ++j) {
+      kept[num_kept] = j;
+      num_kept += keep[j];
+    }
+
+    for (int q = 0; q < num_kept; ++q) {
+      const int j = kept[q];
+      const float x[3] = {view[0][j], view[3][j], view[6][j]};
+      const float y[3] = {view[1][j], view[4][j], view[7][j]};
+      const float h[3] = {view[2][j], view[5][j], view[8][j]};
+      const float area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+      if (std::abs(area) < 1e-9f) continue;  // seen edge-on
+      const float inv_area = 1.0f / area;
+      for (int row = bounds[2][j]; row <= bounds[3][j]; ++row) {
+        const float py = static_cast<float>(row);
+        for (int col = bounds[0][j]; col <= bounds[1][j]; ++col) {
+          const float px = static_cast<float>(col);
+          // Barycentric weights from edge functions; inclusive of edges.
+          const float w0 = ((x[1] - px) * (y[2] - py) - (x[2] - px) * (y[1] - py)) * inv_area;
+          const float w1 = ((x[2] - px) * (y[0] - py) - (x[0] - px) * (y[2] - py)) * inv_area;
+          const float w2 = 1.0f - w0 - w1;
+          constexpr float kEdgeEps = -1e-6f;
+          if (w0 < kEdgeEps || w1 < kEdgeEps || w2 < kEdgeEps) continue;
+          const float height = w0 * h[0] + w1 * h[1] + w2 * h[2];
+          if (height > sf || height < -sf) continue;
+          const std::size_t i = static_cast<std::size_t>(row) * size + col;
+          highest_[i] = std::max(highest_[i], height);
+          lowest_[i] = std::min(lowest_[i], height);
+        }
       }
     }
   }

@@ -18,7 +18,10 @@
 // Triangles are found through a TriangleBvh and rasterised by sampling pixel
 // centres (inclusive edges, so shared edges leave no cracks). Both images of
 // a pair come from one pass: the front image keeps the highest surface along
-// n per pixel, the back image the lowest.
+// n per pixel, the back image the lowest. Dense meshes put a few thousand
+// triangles, most smaller than a pixel, into each view cube, so the renderer
+// culls them in vectorised blocks without branches and tests pixel centres
+// only for the few that can cover one.
 #ifndef MESHSEEK_COMMON_FEATURES_DEPTH_IMAGE_H_
 #define MESHSEEK_COMMON_FEATURES_DEPTH_IMAGE_H_
 
@@ -79,16 +82,10 @@ class DepthImageRenderer {
   const TriangleMesh& mesh_;
   const TriangleBvh& bvh_;
   DepthImageOptions options_;
+  Vec3d origin_;                // centre of the mesh's bounding box
+  std::vector<Vec3f> centred_;  // vertices minus origin_
   std::vector<uint32_t> candidates_;
   std::vector<float> highest_, lowest_;
-  // Per-vertex projection cache: a vertex shared by several candidate
-  // triangles is projected once per view (stamp_ marks the current view).
-  struct Projected {
-    float px = 0, py = 0, h = 0;
-    uint32_t stamp = 0;
-  };
-  std::vector<Projected> projected_;
-  uint32_t current_stamp_ = 0;
 };
 
 // LD-SIFT's post-processing, in place: empty pixels take the largest depth in

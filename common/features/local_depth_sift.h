@@ -33,7 +33,7 @@ std::optional<PrincipalAxes> SupportAxes(const std::vector<Vec3f>& points,
                                          std::vector<uint32_t>* scratch);
 
 // Renders and describes local depth images of one mesh. Holds the mesh's BVH
-// and OpenCV state: one per thread and model; the mesh must outlive it.
+// and scratch buffers: one per thread and model; the mesh must outlive it.
 class LocalDepthSift {
  public:
   LocalDepthSift(const TriangleMesh& mesh,

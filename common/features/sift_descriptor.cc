@@ -1,14 +1,119 @@
 #include "common/features/sift_descriptor.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
-#include <opencv2/core.hpp>
-#include <opencv2/features2d.hpp>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 
 namespace meshseek {
+namespace {
+
+// OpenCV's SIFT constants (sift.simd.hpp).
+constexpr int kCells = 4;             // SIFT_DESCR_WIDTH
+constexpr int kOrientationBins = 8;   // SIFT_DESCR_HIST_BINS
+constexpr float kCellSigmas = 3.0f;   // SIFT_DESCR_SCL_FCTR
+constexpr float kClip = 0.2f;         // SIFT_DESCR_MAG_THR
+constexpr float kByteScale = 512.0f;  // SIFT_INT_DESCR_FCTR
+constexpr float kInputBlur = 0.5f;    // SIFT_INIT_SIGMA
+// The padded histogram of calcSIFTDescriptor: one spare cell on each side of
+// each spatial axis and two spare orientation bins, so that the trilinear
+// update needs no bounds checks.
+constexpr int kPaddedCells = kCells + 2;
+constexpr int kPaddedBins = kOrientationBins + 2;
+constexpr int kHistogramSize = kPaddedCells * kPaddedCells * kPaddedBins;
+
+// atan2 in degrees, [0, 360], by OpenCV's polynomial (cv::fastAtan2; error
+// about 0.01 degree): several times faster than std::atan2, and the same
+// angles OpenCV's descriptor saw. Written with selects rather than branches:
+// the octant of a gradient is unpredictable.
+inline float FastAtan2Degrees(float y, float x) {
+  constexpr float kP1 = 0.9997878412794807f * static_cast<float>(180 / M_PI);
+  constexpr float kP3 = -0.3258083974640975f * static_cast<float>(180 / M_PI);
+  constexpr float kP5 = 0.1555786518463281f * static_cast<float>(180 / M_PI);
+  constexpr float kP7 = -0.04432655554792128f * static_cast<float>(180 / M_PI);
+  constexpr float kEps = static_cast<float>(DBL_EPSILON);
+  const float ax = std::abs(x), ay = std::abs(y);
+  const bool steep = ay > ax;
+  const float c = (steep ? ax : ay) / ((steep ? ay : ax) + kEps), c2 = c * c;
+  const float p = (((kP7 * c2 + kP5) * c2 + kP3) * c2 + kP1) * c;
+  float a = steep ? 90.0f - p : p;
+  a = x < 0 ? 180.0f - a : a;
+  return y < 0 ? 360.0f - a : a;
+}
+
+// cv::borderInterpolate with BORDER_REFLECT_101 (GaussianBlur's default):
+// ... 2 1 | 0 1 2 ... n-1 | n-2 n-3 ...
+int Reflect101(int p, int n) {
+  if (n == 1) return 0;
+  while (p < 0 || p >= n) p = p < 0 ? -p : 2 * n - 2 - p;
+  return p;
+}
+
+// Lowe's dominant orientations (see DominantOrientations) with the Gaussian
+// weight of each pixel given (row-major, image-sized), into `angles`.
+void FindDominantOrientations(const DepthImage& image,
+                              const float* weight,
+                              float peak_ratio,
+                              std::vector<float>* angles) {
+  constexpr int kBins = 36;
+  const int size = image.size;
+  angles->clear();
+  float hist[kBins] = {};
+  for (int r = 1; r + 1 < size; ++r) {
+    const float* above = &image.depth[static_cast<std::size_t>(r - 1) * size];
+    const float* row = above + size;
+    const float* below = row + size;
+    const float* w = weight + static_cast<std::size_t>(r) * size;
+    for (int c = 1; c + 1 < size; ++c) {
+      const float dx = row[c + 1] - row[c - 1];
+      const float dy = above[c] - below[c];  // y up
+      const float magnitude = std::sqrt(dx * dx + dy * dy);
+      if (magnitude <= 0) continue;
+      const float angle = FastAtan2Degrees(dy, dx);
+      const int bin = static_cast<int>(angle * kBins / 360.0f) % kBins;
+      hist[bin] += magnitude * w[c];
+    }
+  }
+  float smooth[kBins];
+  for (int b = 0; b < kBins; ++b) {  // [1 4 6 4 1] / 16, circular, as OpenCV's SIFT
+    auto h = [&](int k) { return hist[(k + kBins) % kBins]; };
+    smooth[b] = (h(b - 2) + h(b + 2)) / 16 + (h(b - 1) + h(b + 1)) * 4 / 16 + h(b) * 6 / 16;
+  }
+  const float highest = *std::max_element(smooth, smooth + kBins);
+  if (!(highest > 0)) return;
+  std::pair<float, float> peaks[kBins];  // (height, angle)
+  int num_peaks = 0;
+  for (int b = 0; b < kBins; ++b) {
+    const float left = smooth[(b + kBins - 1) % kBins], right = smooth[(b + 1) % kBins];
+    if (smooth[b] > left && smooth[b] > right && smooth[b] >= peak_ratio * highest) {
+      const float offset = 0.5f * (left - right) / (left - 2 * smooth[b] + right);
+      const float angle = (b + 0.5f + offset) * 360.0f / kBins;
+      peaks[num_peaks++] = {smooth[b], std::fmod(angle + 360.0f, 360.0f)};
+    }
+  }
+  std::stable_sort(
+      peaks, peaks + num_peaks, [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (int k = 0; k < num_peaks; ++k) angles->push_back(peaks[k].second);
+}
+
+// The centred Gaussian of DominantOrientations, sigma 0.4 I: most of the
+// image, centre first.
+void OrientationWeights(int size, std::vector<float>* weight) {
+  const float centre = (size - 1) / 2.0f;
+  const float sigma = 0.4f * size;
+  weight->resize(static_cast<std::size_t>(size) * size);
+  for (int r = 0; r < size; ++r) {
+    for (int c = 0; c < size; ++c) {
+      const float d2 = (r - centre) * (r - centre) + (c - centre) * (c - centre);
+      (*weight)[static_cast<std::size_t>(r) * size + c] = std::exp(-d2 / (2 * sigma * sigma));
+    }
+  }
+}
+
+}  // namespace
 
 absl::Status SiftDescriptorOptions::Validate() const {
   if (max_orientations < 0) {
@@ -48,124 +153,224 @@ void NormalizeSiftDescriptor(float* bins, uint8_t* out) {
   for (int k = 0; k < kSiftDimension; ++k) bins[k] = std::min(bins[k], 0.2f);
   normalize();
   for (int k = 0; k < kSiftDimension; ++k) {
-    out[k] = static_cast<uint8_t>(std::min(255.0f, std::round(bins[k] * 512.0f)));
+    // Rounded half up (the bins are non-negative), saturated.
+    out[k] = static_cast<uint8_t>(std::min(255.0f, bins[k] * 512.0f + 0.5f));
   }
 }
-
-struct DepthSiftDescriber::Impl {
-  SiftDescriptorOptions options;
-  cv::Ptr<cv::SIFT> sift;
-  cv::Mat gray;
-  std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;
-};
-
-DepthSiftDescriber::DepthSiftDescriber(const SiftDescriptorOptions& options)
-    : impl_(std::make_unique<Impl>()) {
-  impl_->options = options;
-  // Only sigma matters when describing keypoints of octave 0, layer 0; the
-  // rest are OpenCV's detection defaults. (OpenCV still builds the octave's
-  // other layers; fewer layers means coarser steps and longer blur kernels,
-  // measured slower.)
-  impl_->sift = cv::SIFT::create(0, 3, 0.04, 10, options.blur_sigma);
-}
-
-DepthSiftDescriber::~DepthSiftDescriber() = default;
 
 std::vector<float> DominantOrientations(const DepthImage& image, float peak_ratio) {
-  constexpr int kBins = 36;
-  const int size = image.size;
-  const float centre = (size - 1) / 2.0f;
-  const float sigma = 0.4f * size;  // most of the image, centre first
-  float hist[kBins] = {};
-  for (int r = 1; r + 1 < size; ++r) {
-    for (int c = 1; c + 1 < size; ++c) {
-      const float dx = image.at(r, c + 1) - image.at(r, c - 1);
-      const float dy = image.at(r - 1, c) - image.at(r + 1, c);  // y up
-      const float magnitude = std::sqrt(dx * dx + dy * dy);
-      if (magnitude <= 0) continue;
-      const float d2 = (r - centre) * (r - centre) + (c - centre) * (c - centre);
-      float angle = std::atan2(dy, dx) * static_cast<float>(180.0 / M_PI);
-      if (angle < 0) angle += 360.0f;
-      const int bin = static_cast<int>(angle * kBins / 360.0f) % kBins;
-      hist[bin] += magnitude * std::exp(-d2 / (2 * sigma * sigma));
-    }
-  }
-  float smooth[kBins];
-  for (int b = 0; b < kBins; ++b) {  // [1 4 6 4 1] / 16, circular, as OpenCV's SIFT
-    auto h = [&](int k) { return hist[(k + kBins) % kBins]; };
-    smooth[b] = (h(b - 2) + h(b + 2)) / 16 + (h(b - 1) + h(b + 1)) * 4 / 16 + h(b) * 6 / 16;
-  }
-  const float highest = *std::max_element(smooth, smooth + kBins);
-  std::vector<std::pair<float, float>> peaks;  // (height, angle)
-  if (!(highest > 0)) return {};
-  for (int b = 0; b < kBins; ++b) {
-    const float left = smooth[(b + kBins - 1) % kBins], right = smooth[(b + 1) % kBins];
-    if (smooth[b] > left && smooth[b] > right && smooth[b] >= peak_ratio * highest) {
-      const float offset = 0.5f * (left - right) / (left - 2 * smooth[b] + right);
-      const float angle = (b + 0.5f + offset) * 360.0f / kBins;
-      peaks.emplace_back(smooth[b], std::fmod(angle + 360.0f, 360.0f));
-    }
-  }
-  std::stable_sort(
-      peaks.begin(), peaks.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  std::vector<float> angles;
-  for (const auto& peak : peaks) angles.push_back(peak.second);
+  std::vector<float> weight, angles;
+  OrientationWeights(image.size, &weight);
+  FindDominantOrientations(image, weight.data(), peak_ratio, &angles);
   return angles;
 }
 
-int DepthSiftDescriber::Describe(const DepthImage& image, std::vector<uint8_t>* out) {
-  const int size = image.size;
-  cv::Mat& gray = impl_->gray;
-  gray.create(size, size, CV_8U);
+DepthSiftDescriber::DepthSiftDescriber(const SiftDescriptorOptions& options)
+    : options_(options) {
+  // The blur is what cv::GaussianBlur applies to build the base of SIFT's
+  // pyramid (createInitialImage without upscaling): the input is assumed to
+  // carry 0.5 pixel of blur already; the kernel size is OpenCV's automatic
+  // one for float images (8 sigma + 1, odd).
+  const float sigma = static_cast<float>(options.blur_sigma);
+  const float blur = std::sqrt(std::max(sigma * sigma - kInputBlur * kInputBlur, 0.01f));
+  const int taps = static_cast<int>(std::lround(blur * 4 * 2 + 1)) | 1;
+  blur_radius_ = taps / 2;
+  std::vector<double> kernel(taps);
+  double sum = 0;
+  for (int k = 0; k < taps; ++k) {
+    const double x = k - blur_radius_;
+    kernel[k] = std::exp(-x * x / (2.0 * blur * blur));
+    sum += kernel[k];
+  }
+  for (const double k : kernel) kernel_.push_back(static_cast<float>(k / sum));
+}
+
+void DepthSiftDescriber::Prepare(int size) {
+  if (size == size_) return;
+  size_ = size;
+  const int padded = size + 2 * blur_radius_;
+  border_.resize(padded);
+  for (int p = 0; p < padded; ++p) border_[p] = Reflect101(p - blur_radius_, size);
+  // The descriptor window's Gaussian: sigma = half the window (2 cells) in
+  // cell units, cells of 3 keypoint sigmas, keypoint sigma I / 12.
+  const float cell = kCellSigmas * (size / 12.0f);
+  const float scale = -1.0f / (kCells * kCells * 0.5f) / (cell * cell);
+  const int centre = size / 2;
+  window_weight_.resize(static_cast<std::size_t>(size) * size);
+  for (int r = 0; r < size; ++r) {
+    for (int c = 0; c < size; ++c) {
+      const float d2 = static_cast<float>((r - centre) * (r - centre) + (c - centre) * (c - centre));
+      window_weight_[static_cast<std::size_t>(r) * size + c] = std::exp(d2 * scale);
+    }
+  }
+  OrientationWeights(size, &orientation_weight_);
+  gray_.resize(static_cast<std::size_t>(size) * size);
+  rows_.resize(gray_.size());
+  blurred_.resize(gray_.size());
+  padded_.resize(padded);
+  // One sample per interior pixel, row by row: calcSIFTDescriptor's window
+  // (radius 0.88 I) always covers the whole image, and its border pixels have
+  // no central difference. The offsets are fixed; ComputeSamples fills in the
+  // gradients.
+  samples_.clear();
+  for (int r = 1; r + 1 < size; ++r) {
+    for (int c = 1; c + 1 < size; ++c) {
+      samples_.push_back(
+          {static_cast<float>(r - centre), static_cast<float>(c - centre), 0.0f, 0.0f});
+    }
+  }
+}
+
+void DepthSiftDescriber::ComputeSamples(const DepthImage& image) {
+  const int size = size_;
   float lo = 0, hi = 2 * image.support_radius;
-  if (impl_->options.depth_to_gray == DepthToGray::kStretch) {
+  if (options_.depth_to_gray == DepthToGray::kStretch) {
     const auto [mn, mx] = std::minmax_element(image.depth.begin(), image.depth.end());
     lo = *mn;
     hi = *mx;
   }
   const float scale = hi > lo ? 255.0f / (hi - lo) : 0.0f;
+  for (std::size_t i = 0; i < gray_.size(); ++i) {
+    // Rounded half up, as std::lround for these non-negative values.
+    const float g = std::clamp((image.depth[i] - lo) * scale, 0.0f, 255.0f);
+    gray_[i] = static_cast<float>(static_cast<int>(g + 0.5f));
+  }
+  // Separable blur, rows then columns, borders reflected as OpenCV does.
+  const int taps = static_cast<int>(kernel_.size());
   for (int r = 0; r < size; ++r) {
-    uint8_t* row = gray.ptr<uint8_t>(r);
-    for (int c = 0; c < size; ++c) {
-      const float g = (image.at(r, c) - lo) * scale;
-      row[c] = static_cast<uint8_t>(std::clamp(std::lround(g), 0L, 255L));
+    const float* in = &gray_[static_cast<std::size_t>(r) * size];
+    for (std::size_t p = 0; p < border_.size(); ++p) padded_[p] = in[border_[p]];
+    float* out = &rows_[static_cast<std::size_t>(r) * size];
+    std::fill(out, out + size, 0.0f);
+    for (int k = 0; k < taps; ++k) {
+      const float w = kernel_[k];
+      const float* shifted = &padded_[k];
+      for (int c = 0; c < size; ++c) out[c] += w * shifted[c];
     }
   }
-  const float centre = static_cast<float>(size / 2);
-  const float keypoint_size = size / 6.0f;
-  impl_->keypoints.clear();
-  const bool up_axis = impl_->options.orientation == ImageOrientation::kUpAxis;
-  if (up_axis) {
-    impl_->keypoints.emplace_back(centre, centre, keypoint_size, 0.0f);
-  } else {
-    // OpenCV's keypoint angle is clockwise (image y points down): 360 - theta.
-    std::vector<float> thetas = DominantOrientations(image);
-    if (impl_->options.max_orientations > 0 &&
-        static_cast<int>(thetas.size()) > impl_->options.max_orientations) {
-      thetas.resize(impl_->options.max_orientations);
+  for (int r = 0; r < size; ++r) {
+    float* out = &blurred_[static_cast<std::size_t>(r) * size];
+    std::fill(out, out + size, 0.0f);
+    for (int k = 0; k < taps; ++k) {
+      const float* in = &rows_[static_cast<std::size_t>(border_[r + k]) * size];
+      const float w = kernel_[k];
+      for (int c = 0; c < size; ++c) out[c] += w * in[c];
     }
-    for (const float theta : thetas) {
-      const float angle = 360.0f - theta;
-      impl_->keypoints.emplace_back(centre, centre, keypoint_size, angle >= 360.0f ? 0.0f : angle);
-    }
-    // A flat image has no orientation; describe it upright (all zeros anyway).
-    if (impl_->keypoints.empty())
-      impl_->keypoints.emplace_back(centre, centre, keypoint_size, 0.0f);
   }
-  impl_->sift->compute(gray, impl_->keypoints, impl_->descriptors);
-  if (impl_->descriptors.cols != kSiftDimension) return 0;
-  float bins[kSiftDimension];
-  for (int row = 0; row < impl_->descriptors.rows; ++row) {
-    const float* raw = impl_->descriptors.ptr<float>(row);
-    const bool sum_turned = up_axis && impl_->options.symmetrize_180;
+  // Gradients of every interior pixel (see Prepare).
+  Sample* sample = samples_.data();
+  for (int r = 1; r + 1 < size; ++r) {
+    const float* above = &blurred_[static_cast<std::size_t>(r - 1) * size];
+    const float* row = above + size;
+    const float* below = row + size;
+    const float* w = &window_weight_[static_cast<std::size_t>(r) * size];
+    for (int c = 1; c + 1 < size; ++c, ++sample) {
+      const float dx = row[c + 1] - row[c - 1];
+      const float dy = above[c] - below[c];  // y up
+      sample->orientation = FastAtan2Degrees(dy, dx);
+      sample->weighted_magnitude = std::sqrt(dx * dx + dy * dy) * w[c];
+    }
+  }
+}
+
+void DepthSiftDescriber::DescribeAt(float degrees, float* bins) const {
+  const float cell = kCellSigmas * (size_ / 12.0f);
+  const float radians = degrees * static_cast<float>(M_PI / 180);
+  const float cos_t = std::cos(radians) / cell, sin_t = std::sin(radians) / cell;
+  constexpr float kBinsPerDegree = kOrientationBins / 360.0f;
+  float hist[kHistogramSize] = {};
+  for (const Sample& s : samples_) {
+    // Histogram coordinates of the sample, rotated by the orientation;
+    // - 0.5 so that a sample at the centre of a cell lands there with full
+    // weight after interpolation.
+    const float c_rot = s.col * cos_t - s.row * sin_t;
+    const float r_rot = s.col * sin_t + s.row * cos_t;
+    float rbin = r_rot + kCells / 2 - 0.5f;
+    float cbin = c_rot + kCells / 2 - 0.5f;
+    if (!(rbin > -1 && rbin < kCells && cbin > -1 && cbin < kCells)) continue;
+    float obin = (s.orientation - degrees) * kBinsPerDegree;
+    // Floors by truncation of shifted values: rbin, cbin > -1 and obin in
+    // (-8, 8] (both angles in [0, 360]).
+    const int r0 = static_cast<int>(rbin + 1.0f) - 1;
+    const int c0 = static_cast<int>(cbin + 1.0f) - 1;
+    int o0 = static_cast<int>(obin + kOrientationBins) - kOrientationBins;
+    rbin -= r0;
+    cbin -= c0;
+    obin -= o0;
+    o0 += o0 < 0 ? kOrientationBins : 0;
+    o0 -= o0 >= kOrientationBins ? kOrientationBins : 0;
+    // Trilinear interpolation, in OpenCV's order of operations.
+    const float mag = s.weighted_magnitude;
+    const float v_r1 = mag * rbin, v_r0 = mag - v_r1;
+    const float v_rc11 = v_r1 * cbin, v_rc10 = v_r1 - v_rc11;
+    const float v_rc01 = v_r0 * cbin, v_rc00 = v_r0 - v_rc01;
+    const float v_rco111 = v_rc11 * obin, v_rco110 = v_rc11 - v_rco111;
+    const float v_rco101 = v_rc10 * obin, v_rco100 = v_rc10 - v_rco101;
+    const float v_rco011 = v_rc01 * obin, v_rco010 = v_rc01 - v_rco011;
+    const float v_rco001 = v_rc00 * obin, v_rco000 = v_rc00 - v_rco001;
+    float* h = hist + ((r0 + 1) * kPaddedCells + c0 + 1) * kPaddedBins + o0;
+    h[0] += v_rco000;
+    h[1] += v_rco001;
+    h[kPaddedBins] += v_rco010;
+    h[kPaddedBins + 1] += v_rco011;
+    h[kPaddedCells * kPaddedBins] += v_rco100;
+    h[kPaddedCells * kPaddedBins + 1] += v_rco101;
+    h[(kPaddedCells + 1) * kPaddedBins] += v_rco110;
+    h[(kPaddedCells + 1) * kPaddedBins + 1] += v_rco111;
+  }
+  // Orientation histograms are circular: fold the spare bins back.
+  for (int i = 0; i < kCells; ++i) {
+    for (int j = 0; j < kCells; ++j) {
+      float* h = hist + ((i + 1) * kPaddedCells + j + 1) * kPaddedBins;
+      h[0] += h[kOrientationBins];
+      h[1] += h[kOrientationBins + 1];
+      std::copy(h, h + kOrientationBins, bins + (i * kCells + j) * kOrientationBins);
+    }
+  }
+  // OpenCV's normalisation: clip at 0.2 of the norm, scale to 512 / norm of
+  // the clipped vector, round to bytes.
+  float norm2 = 0;
+  for (int k = 0; k < kSiftDimension; ++k) norm2 += bins[k] * bins[k];
+  const float threshold = std::sqrt(norm2) * kClip;
+  norm2 = 0;
+  for (int k = 0; k < kSiftDimension; ++k) {
+    bins[k] = std::min(bins[k], threshold);
+    norm2 += bins[k] * bins[k];
+  }
+  const float factor = kByteScale / std::max(std::sqrt(norm2), FLT_EPSILON);
+  for (int k = 0; k < kSiftDimension; ++k) {
+    bins[k] = static_cast<float>(std::clamp(std::lrint(bins[k] * factor), 0L, 255L));
+  }
+}
+
+int DepthSiftDescriber::Describe(const DepthImage& image, std::vector<uint8_t>* out) {
+  Prepare(image.size);
+  ComputeSamples(image);
+  const bool up_axis = options_.orientation == ImageOrientation::kUpAxis;
+  angles_.clear();
+  if (!up_axis) {
+    FindDominantOrientations(image, orientation_weight_.data(), 0.8f, &angles_);
+    if (options_.max_orientations > 0 &&
+        static_cast<int>(angles_.size()) > options_.max_orientations) {
+      angles_.resize(options_.max_orientations);
+    }
+  }
+  // The up axis, or a flat image without orientation: upright.
+  if (angles_.empty()) angles_.push_back(0.0f);
+  const bool sum_turned = up_axis && options_.symmetrize_180;
+  float raw[kSiftDimension], bins[kSiftDimension];
+  for (const float angle : angles_) {
+    DescribeAt(angle, raw);
+    // The byte-valued result is normalised once more (and, for LD-SIFT,
+    // summed with its 180-degree turn first), as the descriptors OpenCV
+    // returned were when the settings were measured.
     for (int k = 0; k < kSiftDimension; ++k)
       bins[k] = raw[k] + (sum_turned ? raw[Rotate180Index(k)] : 0.0f);
     const std::size_t at = out->size();
     out->resize(at + kSiftDimension);
     NormalizeSiftDescriptor(bins, out->data() + at);
   }
-  return impl_->descriptors.rows;
+  return static_cast<int>(angles_.size());
 }
 
 }  // namespace meshseek

@@ -1,21 +1,32 @@
 // SIFT descriptors of local depth images (DESIGN.md 2.3).
 //
 // One 128-d descriptor (4 x 4 spatial cells x 8 orientations) centred on the
-// image and covering it, computed by OpenCV's cv::SIFT from an 8-bit version of
-// the depth image: a keypoint of size I / 6 at the centre gives a descriptor
-// window of 4 cells x 3 sigma = I pixels. Orientation is fixed by the frame
-// (the PCA up axis is "up" in the image), not by Lowe's dominant gradient.
-// Since the sign of the up axis is arbitrary, LD-SIFT adds the descriptor of
-// the image turned by 180 degrees; that turn is an exact permutation of the
-// descriptor's bins (cell (i, j) -> (3 - i, 3 - j), orientation k -> k + 4), so
-// it costs no second SIFT call. The result is normalised as SIFT does (unit
-// length, entries clipped at 0.2, unit length again) and quantised to bytes
-// (x 512, saturated), the usual storage form of SIFT.
+// image and covering it, as OpenCV's cv::SIFT computes it for a keypoint of
+// size I / 6 at the centre of an 8-bit version of the depth image (descriptor
+// window of 4 cells x 3 sigma = I pixels), but computed here directly: for such
+// a keypoint (octave 0, layer 0) OpenCV describes the base of its Gaussian
+// pyramid, i.e. the image blurred once by sqrt(sigma^2 - 0.5^2), and builds
+// the rest of the pyramid for nothing. This code blurs once and runs OpenCV's
+// calcSIFTDescriptor arithmetic on the result (same window, Gaussian weight,
+// trilinear interpolation, bin layout, 0.2 clipping and byte scaling); the
+// gradients are shared by all orientations of an image. It matches OpenCV's
+// descriptors up to float rounding (sift_descriptor_test compares them on
+// rendered depth images: 99.8 % of McGill's are bit-identical, no byte differs
+// by more than 2) in about a quarter of the time (12 us per 21 x 21 image
+// with its dominant orientations, against 44 us for cv::SIFT alone).
+//
+// Orientation is fixed either by the frame (the PCA up axis is "up" in the
+// image) or by Lowe's dominant gradient orientations. Since the sign of the up
+// axis is arbitrary, LD-SIFT adds the descriptor of the image turned by 180
+// degrees; that turn is an exact permutation of the descriptor's bins (cell
+// (i, j) -> (3 - i, 3 - j), orientation k -> k + 4), so it costs no second
+// descriptor. The result is normalised as SIFT does (unit length, entries
+// clipped at 0.2, unit length again) and quantised to bytes (x 512,
+// saturated), the usual storage form of SIFT.
 #ifndef MESHSEEK_COMMON_FEATURES_SIFT_DESCRIPTOR_H_
 #define MESHSEEK_COMMON_FEATURES_SIFT_DESCRIPTOR_H_
 
 #include <cstdint>
-#include <memory>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -25,7 +36,9 @@ namespace meshseek {
 
 inline constexpr int kSiftDimension = 128;
 
-// How depths become the 8-bit grey levels cv::SIFT requires.
+// How depths become grey levels. They are rounded to 8 bits, as cv::SIFT
+// required when the settings were chosen (the quantisation is part of the
+// measured descriptor).
 enum class DepthToGray {
   // grey = 255 * depth / (2 s): the same depth difference gives the same
   // contrast in every image of the model (scale-invariant, since s scales
@@ -57,9 +70,10 @@ struct SiftDescriptorOptions {
   /// image; 0 keeps every peak within 80 % of the highest, as Lowe does.
   int max_orientations = 0;
   /// Gaussian blur sigma of the image before gradients, in pixels (cv::SIFT's
-  /// `sigma`, which assumes the input already carries 0.5 of blur: 0.5 means
-  /// no extra blur, as in VLFeat's raw descriptor that LD-SIFT's authors used;
-  /// 1.6 is Lowe's and OpenCV's default).
+  /// `sigma`, which assumes the input already carries 0.5 of blur, so the
+  /// image is blurred by sqrt(sigma^2 - 0.5^2): 0.5 means no extra blur, as in
+  /// VLFeat's raw descriptor that LD-SIFT's authors used; 1.6 is Lowe's and
+  /// OpenCV's default).
   double blur_sigma = 1.6;
   /// With kUpAxis: add the 180-degree-turned descriptor (LD-SIFT's cure for
   /// the sign ambiguity of the PCA up axis). Off only for experiments.
@@ -85,22 +99,50 @@ void NormalizeSiftDescriptor(float* bins, uint8_t* out);
 // The bin permutation of a 180-degree image turn: out[k] = in[Rotate180Index(k)].
 int Rotate180Index(int bin);
 
-// Describes depth images. Holds OpenCV state: one per thread.
+// Describes depth images. Holds scratch buffers and per-size tables: one per
+// thread.
 class DepthSiftDescriber {
  public:
   explicit DepthSiftDescriber(const SiftDescriptorOptions& options);
-  ~DepthSiftDescriber();
   DepthSiftDescriber(const DepthSiftDescriber&) = delete;
   DepthSiftDescriber& operator=(const DepthSiftDescriber&) = delete;
 
   // Appends the descriptors of a finished image (FinishDepthImage) to `out`,
   // kSiftDimension bytes each, and returns how many: one with kUpAxis, one or
-  // more with kDominant (none only if OpenCV produced nothing).
+  // more with kDominant (a flat image, which has no orientation, is described
+  // upright).
   int Describe(const DepthImage& image, std::vector<uint8_t>* out);
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  // One gradient sample of the blurred image inside the descriptor window:
+  // offset from the centre (row down, column right), orientation in degrees
+  // (y up) and magnitude times the window's Gaussian weight (which depends on
+  // the distance only, so on no orientation).
+  struct Sample {
+    float row, col;
+    float orientation;
+    float weighted_magnitude;
+  };
+
+  // (Re)builds the tables that depend on the image size only.
+  void Prepare(int size);
+  // Grey levels of `image`, blurred, into blurred_, and their gradient
+  // samples into samples_.
+  void ComputeSamples(const DepthImage& image);
+  // OpenCV's calcSIFTDescriptor on samples_ for orientation `degrees`,
+  // including its normalisation: 128 values in 0..255 (integers) into `bins`.
+  void DescribeAt(float degrees, float* bins) const;
+
+  SiftDescriptorOptions options_;
+  int size_ = 0;
+  int blur_radius_ = 0;
+  std::vector<float> kernel_;              // 2 blur_radius_ + 1 taps
+  std::vector<int> border_;                // padded column -> reflected column
+  std::vector<float> window_weight_;       // Gaussian of the descriptor window
+  std::vector<float> orientation_weight_;  // DominantOrientations' Gaussian
+  std::vector<float> gray_, padded_, rows_, blurred_;
+  std::vector<Sample> samples_;
+  std::vector<float> angles_;
 };
 
 }  // namespace meshseek
