@@ -12,8 +12,11 @@ namespace meshseek {
 namespace {
 
 constexpr char kMagic[4] = {'M', 'S', 'C', 'B'};
-constexpr uint32_t kVersion = 1;
+// Version 1: exact search; version 2: approximate, with its two parameters.
+constexpr uint32_t kExactVersion = 1;
+constexpr uint32_t kApproximateVersion = 2;
 constexpr std::size_t kHeaderBytes = 4 + 4 + 8 + 8;
+constexpr std::size_t kApproximateHeaderBytes = kHeaderBytes + 4 + 4;
 constexpr std::size_t kChecksumBytes = 8;
 
 uint64_t Fnv1a64(absl::string_view bytes) {
@@ -49,8 +52,24 @@ absl::Status CheckCentroids(const std::vector<float>& centroids, std::size_t dim
 
 }  // namespace
 
-Codebook::Codebook(std::vector<float> centroids, std::size_t size, std::size_t dim)
-    : centroids_(std::move(centroids)), index_(centroids_.data(), size, dim) {}
+Codebook::Codebook(std::vector<float> centroids,
+                   std::size_t size,
+                   std::size_t dim,
+                   const std::optional<ApproximateSearchParams>& approximate,
+                   int num_threads)
+    : centroids_(std::move(centroids)), size_(size), dim_(dim) {
+  if (approximate.has_value()) {
+    approximate_ = std::make_shared<const ApproximateNearestCentroidIndex>(
+        centroids_.data(), size, dim, *approximate, num_threads);
+  } else {
+    index_ = NearestCentroidIndex(centroids_.data(), size, dim);
+  }
+}
+
+std::optional<ApproximateSearchParams> Codebook::approximate() const {
+  if (approximate_ == nullptr) return std::nullopt;
+  return approximate_->params();
+}
 
 absl::StatusOr<Codebook> Codebook::Train(const uint8_t* descriptors,
                                          std::size_t count,
@@ -59,10 +78,19 @@ absl::StatusOr<Codebook> Codebook::Train(const uint8_t* descriptors,
                                          KMeansReport* report) {
   MESHSEEK_ASSIGN_OR_RETURN(std::vector<float> centroids,
                             TrainKMeans(descriptors, count, dim, options, report));
-  return Codebook(std::move(centroids), static_cast<std::size_t>(options.num_centroids), dim);
+  std::optional<ApproximateSearchParams> approximate;
+  if (options.UsesApproximateAssignment()) approximate = options.ResolvedApproximateParams();
+  return Codebook(std::move(centroids),
+                  static_cast<std::size_t>(options.num_centroids),
+                  dim,
+                  approximate,
+                  options.num_threads);
 }
 
-absl::StatusOr<Codebook> Codebook::FromCentroids(std::vector<float> centroids, std::size_t dim) {
+absl::StatusOr<Codebook> Codebook::FromCentroids(
+    std::vector<float> centroids,
+    std::size_t dim,
+    std::optional<ApproximateSearchParams> approximate) {
   if (dim == 0) return absl::InvalidArgumentError("codebook: dim must be >= 1, got 0");
   if (centroids.empty() || centroids.size() % dim != 0) {
     return absl::InvalidArgumentError(absl::StrCat("codebook: got ",
@@ -76,8 +104,22 @@ absl::StatusOr<Codebook> Codebook::FromCentroids(std::vector<float> centroids, s
     return absl::InvalidArgumentError(
         absl::StrCat("codebook: ", size, " words (at most 2^32 - 1)"));
   }
+  if (approximate.has_value() &&
+      !(approximate->groups >= 1 && static_cast<std::size_t>(approximate->groups) <= size &&
+        approximate->probes >= 1 && approximate->probes <= approximate->groups)) {
+    return absl::InvalidArgumentError(absl::StrCat("codebook: approximate search with ",
+                                                   approximate->groups,
+                                                   " groups and ",
+                                                   approximate->probes,
+                                                   " probes for ",
+                                                   size,
+                                                   " words (need 1 <= probes <= groups <= "
+                                                   "words)"));
+  }
   MESHSEEK_RETURN_IF_ERROR(CheckCentroids(centroids, dim));
-  return Codebook(std::move(centroids), size, dim);
+  // One thread: a codebook is built on a request path (the service's cache)
+  // and the grouping takes well under a second at V = 20,000.
+  return Codebook(std::move(centroids), size, dim, approximate, /*num_threads=*/1);
 }
 
 absl::StatusOr<std::vector<uint32_t>> Codebook::NearestCentroids(const uint8_t* descriptors,
@@ -87,7 +129,11 @@ absl::StatusOr<std::vector<uint32_t>> Codebook::NearestCentroids(const uint8_t* 
         absl::StrCat("codebook: descriptors is null with count ", count));
   }
   std::vector<uint32_t> labels(count);
-  index_.Search(descriptors, count, /*num_threads=*/1, labels.data(), nullptr);
+  if (approximate_ != nullptr) {
+    approximate_->Search(descriptors, count, /*num_threads=*/1, labels.data(), nullptr);
+  } else {
+    index_.Search(descriptors, count, /*num_threads=*/1, labels.data(), nullptr);
+  }
   return labels;
 }
 
@@ -110,10 +156,14 @@ absl::StatusOr<std::vector<float>> Codebook::Encode(const uint8_t* descriptors,
 
 std::string Codebook::Serialize() const {
   std::string out(kMagic, sizeof(kMagic));
-  out.reserve(kHeaderBytes + centroids_.size() * 4 + kChecksumBytes);
-  PutLittleEndian(kVersion, 4, &out);
+  out.reserve(kApproximateHeaderBytes + centroids_.size() * 4 + kChecksumBytes);
+  PutLittleEndian(approximate_ != nullptr ? kApproximateVersion : kExactVersion, 4, &out);
   PutLittleEndian(size(), 8, &out);
   PutLittleEndian(dim(), 8, &out);
+  if (approximate_ != nullptr) {
+    PutLittleEndian(static_cast<uint32_t>(approximate_->params().groups), 4, &out);
+    PutLittleEndian(static_cast<uint32_t>(approximate_->params().probes), 4, &out);
+  }
   for (float v : centroids_) {
     uint32_t bits;
     std::memcpy(&bits, &v, sizeof(bits));
@@ -135,16 +185,32 @@ absl::StatusOr<Codebook> Codebook::Deserialize(absl::string_view bytes) {
     return absl::InvalidArgumentError("codebook: bad magic (expected \"MSCB\")");
   }
   const uint64_t version = GetLittleEndian(bytes.data() + 4, 4);
-  if (version != kVersion) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "codebook: unsupported version ", version, " (this build reads ", kVersion, ")"));
+  if (version != kExactVersion && version != kApproximateVersion) {
+    return absl::InvalidArgumentError(absl::StrCat("codebook: unsupported version ",
+                                                   version,
+                                                   " (this build reads ",
+                                                   kExactVersion,
+                                                   " and ",
+                                                   kApproximateVersion,
+                                                   ")"));
+  }
+  const std::size_t header =
+      version == kApproximateVersion ? kApproximateHeaderBytes : kHeaderBytes;
+  if (bytes.size() < header + kChecksumBytes) {
+    return absl::InvalidArgumentError(absl::StrCat("codebook: got ",
+                                                   bytes.size(),
+                                                   " bytes, shorter than the version-",
+                                                   version,
+                                                   " header and checksum (",
+                                                   header + kChecksumBytes,
+                                                   " bytes)"));
   }
   const uint64_t size = GetLittleEndian(bytes.data() + 8, 8);
   const uint64_t dim = GetLittleEndian(bytes.data() + 16, 8);
   // Both factors are bounded before multiplying, so the byte count cannot overflow.
-  const uint64_t max_values = (bytes.size() - kHeaderBytes - kChecksumBytes) / 4;
+  const uint64_t max_values = (bytes.size() - header - kChecksumBytes) / 4;
   if (size == 0 || dim == 0 || size > max_values || dim > max_values / size ||
-      kHeaderBytes + size * dim * 4 + kChecksumBytes != bytes.size()) {
+      header + size * dim * 4 + kChecksumBytes != bytes.size()) {
     return absl::InvalidArgumentError(absl::StrCat("codebook: header says ",
                                                    size,
                                                    " words x ",
@@ -157,13 +223,31 @@ absl::StatusOr<Codebook> Codebook::Deserialize(absl::string_view bytes) {
   if (Fnv1a64(bytes.substr(0, payload)) != GetLittleEndian(bytes.data() + payload, 8)) {
     return absl::InvalidArgumentError("codebook: checksum mismatch (corrupt data)");
   }
+  std::optional<ApproximateSearchParams> approximate;
+  if (version == kApproximateVersion) {
+    // Range-checked by FromCentroids; read through int64 so that values past
+    // INT_MAX stay out of range instead of wrapping.
+    const int64_t groups = static_cast<int64_t>(GetLittleEndian(bytes.data() + kHeaderBytes, 4));
+    const int64_t probes =
+        static_cast<int64_t>(GetLittleEndian(bytes.data() + kHeaderBytes + 4, 4));
+    if (groups > static_cast<int64_t>(size) || probes > groups) {
+      return absl::InvalidArgumentError(absl::StrCat("codebook: approximate search with ",
+                                                     groups,
+                                                     " groups and ",
+                                                     probes,
+                                                     " probes for ",
+                                                     size,
+                                                     " words (need 1 <= probes <= groups <= "
+                                                     "words)"));
+    }
+    approximate = ApproximateSearchParams{static_cast<int>(groups), static_cast<int>(probes)};
+  }
   std::vector<float> centroids(size * dim);
   for (std::size_t i = 0; i < centroids.size(); ++i) {
-    const uint32_t bits =
-        static_cast<uint32_t>(GetLittleEndian(bytes.data() + kHeaderBytes + 4 * i, 4));
+    const uint32_t bits = static_cast<uint32_t>(GetLittleEndian(bytes.data() + header + 4 * i, 4));
     std::memcpy(&centroids[i], &bits, sizeof(bits));
   }
-  return FromCentroids(std::move(centroids), dim);
+  return FromCentroids(std::move(centroids), dim, approximate);
 }
 
 }  // namespace meshseek

@@ -3,29 +3,43 @@
 // of the collection's own models, and the encoder that turns one model's local
 // descriptors into a normalised histogram of nearest words.
 //
-// Encoding uses exact nearest-centroid search, the same implementation that
-// assigned points during training (nearest_centroid.h), at about 15 ms for
-// 2,048 descriptors against V = 1,000 on one core. That is fast enough that the
-// approximate kd-tree search DESIGN.md allows is not needed, and exactness
-// keeps encoding identical on every machine and thread count.
+// Encoding uses the same kind of nearest-centroid search that assigned points
+// during training (KMeansOptions::assignment), with the same parameters:
+//  - exact (nearest_centroid.h; the default up to V = 10,000), about 15 ms for
+//    2,048 descriptors against V = 1,000 on one core, identical on every
+//    machine and thread count;
+//  - approximate (approximate_nearest_centroid.h; large vocabularies), the
+//    two-level search: 81 ms CPU per model of 2,500 descriptors at V = 20,000
+//    against 395 ms exact, finding the exact nearest word for 96.6% of them.
+//    A word found is the one training would have assigned the same
+//    descriptor to, so histograms match the clusters.
 //
 // A Codebook is immutable once made; its const methods may be called from
 // several threads at once.
 //
 // Serialised form (for the codebook service to persist), little-endian:
-//   "MSCB" | uint32 version (1) | uint64 V | uint64 dim | V * dim float32,
-//   row-major | uint64 FNV-1a 64 hash of every preceding byte.
+//   exact:        "MSCB" | uint32 version (1) | uint64 V | uint64 dim |
+//                 V * dim float32, row-major | uint64 FNV-1a 64 hash of every
+//                 preceding byte;
+//   approximate:  "MSCB" | uint32 version (2) | uint64 V | uint64 dim |
+//                 uint32 groups | uint32 probes | V * dim float32 | hash.
+// Exact codebooks keep writing version 1, so their bytes are unchanged and
+// older readers read them. The approximate search's grouping is rebuilt from
+// the centroids (it is a deterministic function of them, groups and probes).
 // Deserialize checks every part and rejects anything else.
 #ifndef MESHSEEK_COMMON_BOF_CODEBOOK_H_
 #define MESHSEEK_COMMON_BOF_CODEBOOK_H_
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "common/bof/approximate_nearest_centroid.h"
 #include "common/bof/kmeans.h"
 #include "common/bof/nearest_centroid.h"
 
@@ -35,7 +49,9 @@ class Codebook {
  public:
   /// Learns a codebook of options.num_centroids words by k-means (kmeans.h)
   /// over `count` row-major uint8 descriptors of `dim` values each (a sample
-  /// of the collection's local features; kSiftDimension, 128, for SIFT).
+  /// of the collection's local features; kSiftDimension, 128, for SIFT). The
+  /// codebook encodes with the assignment the training used
+  /// (options.UsesApproximateAssignment() and its resolved parameters).
   /// Errors are TrainKMeans's.
   static absl::StatusOr<Codebook> Train(const uint8_t* descriptors,
                                         std::size_t count,
@@ -43,20 +59,29 @@ class Codebook {
                                         const KMeansOptions& options,
                                         KMeansReport* report = nullptr);
 
-  /// A codebook from existing centroids: V x dim row-major. InvalidArgument
-  /// for dim 0, a size that is not a positive multiple of dim, V >= 2^32, or a
-  /// non-finite value.
-  static absl::StatusOr<Codebook> FromCentroids(std::vector<float> centroids, std::size_t dim);
+  /// A codebook from existing centroids: V x dim row-major, encoding by exact
+  /// search, or by approximate search with `approximate` when given.
+  /// InvalidArgument for dim 0, a size that is not a positive multiple of dim,
+  /// V >= 2^32, a non-finite value, or approximate parameters outside
+  /// 1 <= probes <= groups <= V.
+  static absl::StatusOr<Codebook> FromCentroids(
+      std::vector<float> centroids,
+      std::size_t dim,
+      std::optional<ApproximateSearchParams> approximate = std::nullopt);
 
   /// Number of visual words V.
-  std::size_t size() const { return index_.num_centroids(); }
+  std::size_t size() const { return size_; }
   /// Dimension of a descriptor.
-  std::size_t dim() const { return index_.dim(); }
+  std::size_t dim() const { return dim_; }
   /// V x dim row-major.
   const std::vector<float>& centroids() const { return centroids_; }
+  /// The approximate search's parameters when the codebook encodes with it;
+  /// nullopt when it encodes by exact search.
+  std::optional<ApproximateSearchParams> approximate() const;
 
   /// Index of the nearest word for each of `count` descriptors (count x dim()
-  /// row-major; ties go to the lowest index). Runs on the calling thread only:
+  /// row-major; ties go to the lowest index), by the codebook's search (exact,
+  /// or approximate: see above). Runs on the calling thread only:
   /// meshseek parallelises across models (parallel.h). InvalidArgument for null
   /// descriptors with count > 0.
   absl::StatusOr<std::vector<uint32_t>> NearestCentroids(const uint8_t* descriptors,
@@ -77,10 +102,19 @@ class Codebook {
   static absl::StatusOr<Codebook> Deserialize(absl::string_view bytes);
 
  private:
-  Codebook(std::vector<float> centroids, std::size_t size, std::size_t dim);
+  Codebook(std::vector<float> centroids,
+           std::size_t size,
+           std::size_t dim,
+           const std::optional<ApproximateSearchParams>& approximate,
+           int num_threads);
 
   std::vector<float> centroids_;
+  std::size_t size_ = 0;
+  std::size_t dim_ = 0;
+  // Exactly one of the two is built: index_ for exact search, approximate_
+  // (shared: immutable, and copies of a Codebook need not regroup) otherwise.
   NearestCentroidIndex index_;
+  std::shared_ptr<const ApproximateNearestCentroidIndex> approximate_;
 };
 
 }  // namespace meshseek

@@ -163,8 +163,12 @@ TEST(CodebookTest, DeserializeRejectsCorruptInput) {
   EXPECT_THAT(message(bad), HasSubstr("bad magic"));
 
   bad = good;
-  bad[4] = 2;
-  EXPECT_THAT(message(bad), HasSubstr("unsupported version 2"));
+  bad[4] = 3;
+  EXPECT_THAT(message(bad), HasSubstr("unsupported version 3 (this build reads 1 and 2)"));
+
+  bad = good;
+  bad[4] = 2;  // a version-1 body read with the longer version-2 header
+  EXPECT_THAT(message(bad), HasSubstr("inconsistent with"));
 
   bad = good;
   bad[8] = 0;  // V = 0
@@ -183,6 +187,66 @@ TEST(CodebookTest, DeserializeRejectsCorruptInput) {
   std::memcpy(&bad[24 + 4 * 4], &nan, 4);  // centroid 1, coordinate 1 (little-endian host)
   Rehash(&bad);
   EXPECT_THAT(message(bad), HasSubstr("centroid 1, coordinate 1 is nan"));
+}
+
+TEST(CodebookTest, TrainedCodebookEncodesWithTheTrainingsAssignment) {
+  const std::vector<uint8_t> descriptors = RandomDescriptors(3000, kDim, 9);
+  KMeansOptions options;
+  options.num_centroids = 40;
+  options.min_points_per_centroid = 1;
+  options.max_iterations = 3;
+  const Codebook exact = Codebook::Train(descriptors.data(), 3000, kDim, options).value();
+  EXPECT_FALSE(exact.approximate().has_value());
+  EXPECT_EQ(exact.Serialize()[4], 1);  // exact codebooks keep the version-1 form
+
+  options.assignment = KMeansOptions::Assignment::kApproximate;
+  options.approximate_probes = 2;
+  const Codebook approx = Codebook::Train(descriptors.data(), 3000, kDim, options).value();
+  ASSERT_TRUE(approx.approximate().has_value());
+  EXPECT_EQ(*approx.approximate(), (ApproximateSearchParams{9, 2}));
+  // The codebook's words are those of the approximate search over its centroids.
+  std::vector<uint32_t> expected(3000);
+  ApproximateNearestCentroidIndex(approx.centroids().data(), 40, kDim, {9, 2}, 1)
+      .Search(descriptors.data(), 3000, 1, expected.data(), nullptr);
+  EXPECT_EQ(approx.NearestCentroids(descriptors.data(), 3000).value(), expected);
+}
+
+TEST(CodebookTest, ApproximateCodebookRoundTrips) {
+  const Codebook exact = RandomCodebook(37, 9, 7);
+  const Codebook codebook =
+      Codebook::FromCentroids(exact.centroids(), 9, ApproximateSearchParams{6, 2}).value();
+  const std::string bytes = codebook.Serialize();
+  EXPECT_EQ(bytes.size(), 32 + 37 * 9 * 4 + 8u);
+  EXPECT_EQ(bytes[4], 2);
+  const absl::StatusOr<Codebook> restored = Codebook::Deserialize(bytes);
+  ASSERT_TRUE(restored.ok()) << restored.status();
+  ASSERT_TRUE(restored->approximate().has_value());
+  EXPECT_EQ(*restored->approximate(), (ApproximateSearchParams{6, 2}));
+  EXPECT_EQ(restored->centroids(), exact.centroids());
+  EXPECT_EQ(restored->Serialize(), bytes);
+  const std::vector<uint8_t> descriptors = RandomDescriptors(500, 9, 10);
+  EXPECT_EQ(restored->NearestCentroids(descriptors.data(), 500).value(),
+            codebook.NearestCentroids(descriptors.data(), 500).value());
+}
+
+TEST(CodebookTest, ApproximateParametersAreValidated) {
+  const std::vector<float> centroids = RandomCodebook(10, 2, 3).centroids();
+  for (const ApproximateSearchParams& p : {ApproximateSearchParams{0, 1},
+                                           ApproximateSearchParams{11, 1},
+                                           ApproximateSearchParams{4, 5},
+                                           ApproximateSearchParams{4, 0}}) {
+    EXPECT_THAT(std::string(Codebook::FromCentroids(centroids, 2, p).status().message()),
+                HasSubstr("probes <= groups <= words"))
+        << p.groups << " " << p.probes;
+  }
+  // The same through the serialised form: groups = 2^32 - 1 for 10 words.
+  std::string bad = Codebook::FromCentroids(centroids, 2, ApproximateSearchParams{3, 1})
+                        .value()
+                        .Serialize();
+  for (int i = 24; i < 28; ++i) bad[i] = static_cast<char>(0xff);
+  Rehash(&bad);
+  EXPECT_THAT(std::string(Codebook::Deserialize(bad).status().message()),
+              HasSubstr("approximate search with 4294967295 groups and 1 probes for 10 words"));
 }
 
 }  // namespace

@@ -4,8 +4,11 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <random>
+#include <string>
 #include <type_traits>
+#include <unordered_set>
 
 #include "absl/strings/str_cat.h"
 #include "common/base/logging.h"
@@ -126,12 +129,50 @@ std::vector<float> SeedKMeansPlusPlus(const std::vector<float>& init,
   return seeds;
 }
 
+// k distinct rows of `train` (by value), visited in a random order: a
+// partial Fisher-Yates shuffle stops as soon as k distinct values have been
+// seen. If there are fewer than k, the rest are duplicates of random rows, as
+// in SeedKMeansPlusPlus. Sets *examined to the rows looked at.
+template <typename T>
+std::vector<float> SeedRandomDistinct(const T* train,
+                                      std::size_t n,
+                                      std::size_t dim,
+                                      std::size_t k,
+                                      Rng& rng,
+                                      std::size_t* examined) {
+  std::vector<float> seeds(k * dim);
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::unordered_set<std::string> seen;
+  seen.reserve(2 * k);
+  std::size_t c = 0, i = 0;
+  for (; i < n && c < k; ++i) {
+    std::swap(order[i], order[i + UniformIndex(rng, n - i)]);
+    const T* row = train + order[i] * dim;
+    if (!seen.emplace(reinterpret_cast<const char*>(row), dim * sizeof(T)).second) continue;
+    for (std::size_t d = 0; d < dim; ++d) seeds[c * dim + d] = static_cast<float>(row[d]);
+    ++c;
+  }
+  *examined = i;
+  if (c < k) {
+    MESHSEEK_LOG(WARNING) << "k-means: the " << n << " training points have only " << c
+                          << " distinct values for " << k
+                          << " centroids; the rest start as duplicates";
+    for (; c < k; ++c) {
+      const T* row = train + UniformIndex(rng, n) * dim;
+      for (std::size_t d = 0; d < dim; ++d) seeds[c * dim + d] = static_cast<float>(row[d]);
+    }
+  }
+  return seeds;
+}
+
 template <typename T>
 absl::StatusOr<std::vector<float>> TrainKMeansImpl(const T* points,
                                                    std::size_t n,
                                                    std::size_t dim,
                                                    const KMeansOptions& options,
-                                                   KMeansReport* report) {
+                                                   KMeansReport* report,
+                                                   bool log_summary) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   const std::size_t k = static_cast<std::size_t>(options.num_centroids);
   if (dim == 0) return absl::InvalidArgumentError("k-means: dim must be >= 1, got 0");
@@ -171,30 +212,45 @@ absl::StatusOr<std::vector<float>> TrainKMeansImpl(const T* points,
   }
 
   // 2. Seed.
-  const std::size_t m = std::min(
-      n_train, std::max(k, k * static_cast<std::size_t>(options.init_points_per_centroid)));
-  std::vector<float> init(m * dim);
-  {
-    const std::vector<std::size_t> rows = SampleIndices(n_train, m, rng);
-    for (std::size_t i = 0; i < m; ++i) {
-      for (std::size_t d = 0; d < dim; ++d) {
-        init[i * dim + d] = static_cast<float>(train[rows[i] * dim + d]);
+  std::vector<float> centroids;
+  rep.kmeans_plus_plus = options.UsesKMeansPlusPlus();
+  if (rep.kmeans_plus_plus) {
+    const std::size_t m = std::min(
+        n_train, std::max(k, k * static_cast<std::size_t>(options.init_points_per_centroid)));
+    std::vector<float> init(m * dim);
+    {
+      const std::vector<std::size_t> rows = SampleIndices(n_train, m, rng);
+      for (std::size_t i = 0; i < m; ++i) {
+        for (std::size_t d = 0; d < dim; ++d) {
+          init[i * dim + d] = static_cast<float>(train[rows[i] * dim + d]);
+        }
       }
     }
+    rep.init_points = m;
+    centroids = SeedKMeansPlusPlus(init, m, dim, k, options.num_threads, rng);
+  } else {
+    centroids = SeedRandomDistinct(train, n_train, dim, k, rng, &rep.init_points);
   }
-  rep.init_points = m;
-  std::vector<float> centroids = SeedKMeansPlusPlus(init, m, dim, k, options.num_threads, rng);
-  init = std::vector<float>();
 
   // 3. Lloyd.
+  rep.approximate_assignment = options.UsesApproximateAssignment();
+  if (rep.approximate_assignment) rep.approximate = options.ResolvedApproximateParams();
+  auto assign = [&](const std::vector<float>& c, uint32_t* labels, float* distances) {
+    if (rep.approximate_assignment) {
+      ApproximateNearestCentroidIndex(c.data(), k, dim, rep.approximate, options.num_threads)
+          .Search(train, n_train, options.num_threads, labels, distances);
+    } else {
+      NearestCentroidIndex(c.data(), k, dim)
+          .Search(train, n_train, options.num_threads, labels, distances);
+    }
+  };
   std::vector<uint32_t> labels(n_train), previous_labels;
   std::vector<float> distances(n_train);
   std::vector<std::size_t> offsets(k + 1), order(n_train), counts(k);
   double previous_objective = 0.0;
   bool split_before = false;
   for (int it = 0; it < options.max_iterations; ++it) {
-    NearestCentroidIndex index(centroids.data(), k, dim);
-    index.Search(train, n_train, options.num_threads, labels.data(), distances.data());
+    assign(centroids, labels.data(), distances.data());
     double objective = 0.0;
     for (float v : distances) objective += v;
     objective /= static_cast<double>(n_train);
@@ -245,10 +301,20 @@ absl::StatusOr<std::vector<float>> TrainKMeansImpl(const T* points,
     previous_labels.swap(labels);
     labels.resize(n_train);
   }
-  MESHSEEK_LOG(INFO) << "k-means: " << k << " centroids from " << n_train << " of " << n
-                     << " points, " << rep.iterations << " iterations"
-                     << (rep.converged ? " (converged)" : "") << ", mean squared distance "
-                     << (rep.objective.empty() ? 0.0 : rep.objective.back());
+  if (log_summary) {
+    MESHSEEK_LOG(INFO) << "k-means: " << k << " centroids from " << n_train << " of " << n
+                       << " points, " << rep.iterations << " iterations"
+                       << (rep.converged ? " (converged)" : "") << ", "
+                       << (rep.approximate_assignment
+                               ? absl::StrCat("approximate assignment (",
+                                              rep.approximate.groups,
+                                              " groups, ",
+                                              rep.approximate.probes,
+                                              " probes)")
+                               : std::string("exact assignment"))
+                       << ", mean squared distance "
+                       << (rep.objective.empty() ? 0.0 : rep.objective.back());
+  }
   return centroids;
 }
 
@@ -276,7 +342,61 @@ absl::Status KMeansOptions::Validate() const {
   if (init_points_per_centroid < 1) {
     return bad("init_points_per_centroid", init_points_per_centroid, ">= 1");
   }
+  if (assignment != Assignment::kAuto && assignment != Assignment::kExact &&
+      assignment != Assignment::kApproximate) {
+    return bad("assignment", static_cast<int>(assignment), "kAuto, kExact or kApproximate");
+  }
+  if (approximate_min_centroids < 1) {
+    return bad("approximate_min_centroids", approximate_min_centroids, ">= 1");
+  }
+  if (approximate_groups < 0) {
+    return bad("approximate_groups", approximate_groups, ">= 0 (0: automatic)");
+  }
+  if (approximate_groups > num_centroids) {
+    return bad("approximate_groups",
+               approximate_groups,
+               absl::StrCat("<= num_centroids (", num_centroids, ")").c_str());
+  }
+  if (approximate_probes < 1) return bad("approximate_probes", approximate_probes, ">= 1");
+  if (approximate_groups > 0 && approximate_probes > approximate_groups) {
+    return bad("approximate_probes",
+               approximate_probes,
+               absl::StrCat("<= approximate_groups (", approximate_groups, ")").c_str());
+  }
+  if (seeding != Seeding::kAuto && seeding != Seeding::kKMeansPlusPlus &&
+      seeding != Seeding::kRandomDistinct) {
+    return bad("seeding", static_cast<int>(seeding), "kAuto, kKMeansPlusPlus or kRandomDistinct");
+  }
   return absl::OkStatus();
+}
+
+bool KMeansOptions::UsesApproximateAssignment() const {
+  switch (assignment) {
+    case Assignment::kExact:
+      return false;
+    case Assignment::kApproximate:
+      return true;
+    case Assignment::kAuto:
+      break;
+  }
+  return num_centroids >= approximate_min_centroids;
+}
+
+ApproximateSearchParams KMeansOptions::ResolvedApproximateParams() const {
+  return ApproximateSearchParams::Resolve(
+      approximate_groups, approximate_probes, static_cast<std::size_t>(std::max(1, num_centroids)));
+}
+
+bool KMeansOptions::UsesKMeansPlusPlus() const {
+  switch (seeding) {
+    case Seeding::kKMeansPlusPlus:
+      return true;
+    case Seeding::kRandomDistinct:
+      return false;
+    case Seeding::kAuto:
+      break;
+  }
+  return !UsesApproximateAssignment();
 }
 
 absl::StatusOr<std::vector<float>> TrainKMeans(const float* points,
@@ -284,7 +404,7 @@ absl::StatusOr<std::vector<float>> TrainKMeans(const float* points,
                                                std::size_t dim,
                                                const KMeansOptions& options,
                                                KMeansReport* report) {
-  return TrainKMeansImpl(points, n, dim, options, report);
+  return TrainKMeansImpl(points, n, dim, options, report, /*log_summary=*/true);
 }
 
 absl::StatusOr<std::vector<float>> TrainKMeans(const uint8_t* points,
@@ -292,10 +412,18 @@ absl::StatusOr<std::vector<float>> TrainKMeans(const uint8_t* points,
                                                std::size_t dim,
                                                const KMeansOptions& options,
                                                KMeansReport* report) {
-  return TrainKMeansImpl(points, n, dim, options, report);
+  return TrainKMeansImpl(points, n, dim, options, report, /*log_summary=*/true);
 }
 
 namespace internal {
+
+absl::StatusOr<std::vector<float>> TrainKMeansQuietly(const float* points,
+                                                      std::size_t n,
+                                                      std::size_t dim,
+                                                      const KMeansOptions& options,
+                                                      KMeansReport* report) {
+  return TrainKMeansImpl(points, n, dim, options, report, /*log_summary=*/false);
+}
 
 std::size_t SplitEmptyClusters(std::size_t dim,
                                std::vector<float>* centroids,

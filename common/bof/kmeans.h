@@ -7,7 +7,7 @@
 //      centroid (as Faiss does): Lloyd costs n * k * dim per iteration, and a few
 //      hundred points per centroid already pin a centroid down. Warn below
 //      min_points_per_centroid.
-//   2. Seed with k-means++ run on a smaller random subset
+//   2. Seed (KMeansOptions::seeding) with k-means++ run on a smaller random subset
 //      (init_points_per_centroid per centroid). Why not plain random points
 //      (Faiss's default): depth-image SIFT has many identical descriptors (flat
 //      patches give all-zero gradients), so random seeds land on duplicates and
@@ -16,11 +16,16 @@
 //      Why on a subset: k-means++ is k sequential passes over its points
 //      (O(m k dim)); on 8 points per centroid it costs a fraction of one Lloyd
 //      iteration over 256 per centroid, while the seeds only need to be spread,
-//      not precise: Lloyd refines them.
-//   3. Lloyd iterations: exact nearest-centroid assignment (nearest_centroid.h),
-//      then centroid = mean of its points. Stop after max_iterations, when no
-//      assignment changes, or when an iteration lowers the objective by less than
-//      `tolerance` (relative).
+//      not precise: Lloyd refines them. k-means++ is still O(k^2) however
+//      small the subset (V = 20,000: 0.8 TFLOP of sequential passes, minutes),
+//      so large vocabularies are seeded with k distinct random training points
+//      instead: distinct by value, which keeps what k-means++ was chosen for
+//      (no seed duplicates the all-zero descriptor).
+//   3. Lloyd iterations: nearest-centroid assignment, exact (nearest_centroid.h)
+//      or, for large vocabularies, approximate (approximate_nearest_centroid.h;
+//      KMeansOptions::assignment), then centroid = mean of its points. Stop
+//      after max_iterations, when no assignment changes, or when an iteration
+//      lowers the objective by less than `tolerance` (relative).
 //   4. Empty clusters are split Faiss-style: the empty centroid takes a copy of
 //      the centroid of the largest cluster (lowest index on ties), and the two
 //      are pushed apart by a relative 1/1024 in opposite directions,
@@ -31,8 +36,9 @@
 // options.seed, turned into numbers by meshseek's own arithmetic (not the
 // library-defined std distributions), so the same input and seed give the same
 // centroids with any standard library. Every reduction runs in a fixed order
-// (per-centroid sums over points in index order, in double), so the result is
-// bit-identical for any num_threads.
+// (per-centroid sums over points in index order, in double), and both
+// assignment searches are bit-identical for any thread count, so the result is
+// bit-identical for any num_threads, with either assignment.
 #ifndef MESHSEEK_COMMON_BOF_KMEANS_H_
 #define MESHSEEK_COMMON_BOF_KMEANS_H_
 
@@ -42,10 +48,32 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "common/bof/approximate_nearest_centroid.h"
 
 namespace meshseek {
 
 struct KMeansOptions {
+  /// How a point finds its nearest centroid, in the Lloyd iterations and, for
+  /// a Codebook trained with these options, when encoding.
+  enum class Assignment {
+    /// kExact below approximate_min_centroids centroids, kApproximate from there.
+    kAuto,
+    /// The true nearest centroid (nearest_centroid.h).
+    kExact,
+    /// The nearest among the centroids of the approximate_probes nearest of
+    /// approximate_groups groups (approximate_nearest_centroid.h).
+    kApproximate,
+  };
+  /// How the initial centroids are chosen (step 2 above).
+  enum class Seeding {
+    /// kKMeansPlusPlus with exact assignment, kRandomDistinct with approximate.
+    kAuto,
+    /// k-means++ on init_points_per_centroid points per centroid; O(k^2).
+    kKMeansPlusPlus,
+    /// k training points drawn at random, skipping values already drawn; O(n).
+    kRandomDistinct,
+  };
+
   /// Number of centroids k, i.e. the vocabulary size V (DESIGN.md 2.7: 500..5,000).
   int num_centroids = 1000;
   /// Maximum number of Lloyd iterations (one assignment and one update each).
@@ -69,9 +97,38 @@ struct KMeansOptions {
   /// k-means++ seeding runs on a random subset of this many points per centroid
   /// (or on the whole training set if that is smaller).
   int init_points_per_centroid = 8;
+  /// See Assignment. The default keeps today's exact search for the
+  /// vocabularies of DESIGN.md 2.7 (V <= 5,000) and switches to the
+  /// approximate one where exact training and encoding become too slow.
+  Assignment assignment = Assignment::kAuto;
+  /// kAuto's threshold on num_centroids. At V = 10,000 over 500,000 SIFT-like
+  /// descriptors 3 exact Lloyd iterations (with k-means++) took 134 CPU s
+  /// against 18 approximate, whose search finds the exact nearest word for
+  /// 97.8% of the points (bench/results/codebook.txt). Below it exact search
+  /// stays the default: DESIGN.md 2.7's V <= 5,000 trains as before, bit for bit.
+  int approximate_min_centroids = 10000;
+  /// Number of groups G of the approximate search; 0 picks sqrt(probes * V),
+  /// which minimises the distances computed per point (G + probes * V / G).
+  /// At most num_centroids.
+  int approximate_groups = 0;
+  /// Groups searched per point by the approximate search. More probes: closer
+  /// to exact, proportionally slower. At V = 20,000 on SIFT-like descriptors
+  /// 4 / 8 / 16 probes find the exact nearest word for 96.3 / 99.0 / 99.7% of
+  /// them at 0.16 / 0.20 / 0.30 of exact search's time (bench/results/codebook.txt).
+  int approximate_probes = 8;
+  /// See Seeding.
+  Seeding seeding = Seeding::kAuto;
 
   /// InvalidArgument naming the first bad field and its value.
   absl::Status Validate() const;
+
+  /// Whether assignment (kAuto resolved with num_centroids) is approximate.
+  bool UsesApproximateAssignment() const;
+  /// The approximate search's parameters for num_centroids, resolved
+  /// (ApproximateSearchParams::Resolve).
+  ApproximateSearchParams ResolvedApproximateParams() const;
+  /// Whether seeding (kAuto resolved) is k-means++.
+  bool UsesKMeansPlusPlus() const;
 };
 
 /// What TrainKMeans did.
@@ -82,6 +139,9 @@ struct KMeansReport {
   int iterations = 0;                    ///< Lloyd iterations run
   bool converged = false;                ///< stopped by tolerance or unchanged assignments
   std::size_t empty_clusters_split = 0;  ///< empty clusters re-seeded, over all iterations
+  bool approximate_assignment = false;   ///< whether assignment was approximate
+  ApproximateSearchParams approximate;   ///< its parameters, when it was
+  bool kmeans_plus_plus = false;         ///< seeded by k-means++ (else random distinct)
   /// Mean squared distance of the training points to their nearest centroid, at
   /// each iteration's assignment (before its update).
   std::vector<double> objective;
@@ -110,6 +170,14 @@ absl::StatusOr<std::vector<float>> TrainKMeans(const uint8_t* points,
                                                KMeansReport* report = nullptr);
 
 namespace internal {
+
+/// TrainKMeans without the summary line it logs at INFO: the approximate
+/// search groups the centroids by k-means once per Lloyd iteration.
+absl::StatusOr<std::vector<float>> TrainKMeansQuietly(const float* points,
+                                                      std::size_t n,
+                                                      std::size_t dim,
+                                                      const KMeansOptions& options,
+                                                      KMeansReport* report);
 
 /// Step 4 above, exposed for tests: for each c with counts[c] == 0 (in
 /// increasing c), splits the cluster with the largest count (lowest index on

@@ -64,6 +64,34 @@ TEST(KMeansOptionsTest, DefaultsAreValidAndPinned) {
   EXPECT_EQ(options.max_points_per_centroid, 256);
   EXPECT_EQ(options.min_points_per_centroid, 39);
   EXPECT_EQ(options.init_points_per_centroid, 8);
+  EXPECT_EQ(options.assignment, KMeansOptions::Assignment::kAuto);
+  EXPECT_EQ(options.approximate_min_centroids, 10000);
+  EXPECT_EQ(options.approximate_groups, 0);
+  EXPECT_EQ(options.approximate_probes, 8);
+  EXPECT_EQ(options.seeding, KMeansOptions::Seeding::kAuto);
+}
+
+// Exact search (and k-means++) at today's vocabularies, approximate search
+// (and random distinct seeding) from approximate_min_centroids on.
+TEST(KMeansOptionsTest, AutomaticChoicesFollowTheVocabularySize) {
+  KMeansOptions options;
+  options.num_centroids = 2000;
+  EXPECT_FALSE(options.UsesApproximateAssignment());
+  EXPECT_TRUE(options.UsesKMeansPlusPlus());
+  options.num_centroids = 9999;
+  EXPECT_FALSE(options.UsesApproximateAssignment());
+  options.num_centroids = 10000;
+  EXPECT_TRUE(options.UsesApproximateAssignment());
+  EXPECT_FALSE(options.UsesKMeansPlusPlus());
+  EXPECT_EQ(options.ResolvedApproximateParams(), (ApproximateSearchParams{283, 8}));
+  options.seeding = KMeansOptions::Seeding::kKMeansPlusPlus;
+  EXPECT_TRUE(options.UsesKMeansPlusPlus());
+  options.assignment = KMeansOptions::Assignment::kExact;
+  EXPECT_FALSE(options.UsesApproximateAssignment());
+  options.num_centroids = 10;
+  options.assignment = KMeansOptions::Assignment::kApproximate;
+  EXPECT_TRUE(options.UsesApproximateAssignment());
+  EXPECT_EQ(options.ResolvedApproximateParams(), (ApproximateSearchParams{9, 8}));
 }
 
 TEST(KMeansOptionsTest, RejectsBadFieldsNamingThem) {
@@ -85,6 +113,23 @@ TEST(KMeansOptionsTest, RejectsBadFieldsNamingThem) {
        "min_points_per_centroid must be <= max_points_per_centroid (256), got 300"},
       {[](KMeansOptions& o) { o.init_points_per_centroid = 0; },
        "init_points_per_centroid must be >= 1, got 0"},
+      {[](KMeansOptions& o) { o.assignment = static_cast<KMeansOptions::Assignment>(7); },
+       "assignment must be kAuto, kExact or kApproximate, got 7"},
+      {[](KMeansOptions& o) { o.approximate_min_centroids = 0; },
+       "approximate_min_centroids must be >= 1, got 0"},
+      {[](KMeansOptions& o) { o.approximate_groups = -1; },
+       "approximate_groups must be >= 0 (0: automatic), got -1"},
+      {[](KMeansOptions& o) { o.approximate_groups = 1001; },
+       "approximate_groups must be <= num_centroids (1000), got 1001"},
+      {[](KMeansOptions& o) { o.approximate_probes = 0; },
+       "approximate_probes must be >= 1, got 0"},
+      {[](KMeansOptions& o) {
+         o.approximate_groups = 4;
+         o.approximate_probes = 5;
+       },
+       "approximate_probes must be <= approximate_groups (4), got 5"},
+      {[](KMeansOptions& o) { o.seeding = static_cast<KMeansOptions::Seeding>(-1); },
+       "seeding must be kAuto, kKMeansPlusPlus or kRandomDistinct, got -1"},
   };
   for (const Case& c : cases) {
     KMeansOptions options;
@@ -246,6 +291,86 @@ TEST(TrainKMeansTest, SubSamplesAndReports) {
   EXPECT_EQ(report.training_points, 250u);
   EXPECT_EQ(report.init_points, 20u);
   EXPECT_EQ(report.objective.size(), static_cast<std::size_t>(report.iterations));
+}
+
+KMeansOptions ApproximateOptions(int k) {
+  KMeansOptions options = SmallOptions(k);
+  options.assignment = KMeansOptions::Assignment::kApproximate;
+  options.approximate_probes = 3;
+  return options;
+}
+
+TEST(TrainKMeansTest, ApproximateAssignmentIsDeterministicAndIndependentOfThreadCount) {
+  const std::size_t k = 150, dim = 16;
+  Blobs blobs = MakeBlobs(200, 45, dim, 13);  // 9,000 points: three search blocks
+  for (float& v : blobs.points) v *= 0.05f;
+  const std::size_t n = blobs.points.size() / dim;
+  KMeansOptions options = ApproximateOptions(k);
+  options.seed = 9;
+  options.max_iterations = 6;
+  options.num_threads = 1;
+  KMeansReport report1, report2;
+  const auto one = TrainKMeans(blobs.points.data(), n, dim, options, &report1);
+  const auto again = TrainKMeans(blobs.points.data(), n, dim, options);
+  options.num_threads = 2;
+  const auto two = TrainKMeans(blobs.points.data(), n, dim, options, &report2);
+  ASSERT_TRUE(one.ok() && again.ok() && two.ok());
+  EXPECT_EQ(*one, *again);
+  EXPECT_EQ(*one, *two);
+  EXPECT_EQ(report1.objective, report2.objective);
+  EXPECT_TRUE(report1.approximate_assignment);
+  EXPECT_EQ(report1.approximate, (ApproximateSearchParams{21, 3}));
+  EXPECT_FALSE(report1.kmeans_plus_plus);
+
+  options.seed = 10;
+  const auto other = TrainKMeans(blobs.points.data(), n, dim, options);
+  ASSERT_TRUE(other.ok());
+  EXPECT_NE(*one, *other);
+}
+
+// From the same (k-means++) seeds, approximate assignment reaches the
+// objective of exact assignment on overlapping clusters, within 2%.
+TEST(TrainKMeansTest, ApproximateAssignmentNearlyMatchesExactObjective) {
+  const std::size_t k = 100, dim = 16;
+  Blobs blobs = MakeBlobs(150, 40, dim, 17);
+  for (float& v : blobs.points) v *= 0.05f;
+  const std::size_t n = blobs.points.size() / dim;
+  KMeansOptions approx = ApproximateOptions(k);
+  approx.seeding = KMeansOptions::Seeding::kKMeansPlusPlus;
+  approx.approximate_probes = 8;  // the default: 8 of 28 groups
+  KMeansReport exact_report, approx_report;
+  ASSERT_TRUE(TrainKMeans(blobs.points.data(), n, dim, SmallOptions(k), &exact_report).ok());
+  ASSERT_TRUE(TrainKMeans(blobs.points.data(), n, dim, approx, &approx_report).ok());
+  EXPECT_FALSE(exact_report.approximate_assignment);
+  EXPECT_TRUE(approx_report.approximate_assignment);
+  std::printf("objective: exact %.4f, approximate %.4f\n",
+              exact_report.objective.back(),
+              approx_report.objective.back());
+  EXPECT_LE(approx_report.objective.back(), 1.02 * exact_report.objective.back());
+}
+
+TEST(TrainKMeansTest, RandomDistinctSeedingSkipsDuplicateValues) {
+  // 90% of the points are one value (the all-zero descriptor); five distinct
+  // others. Six centroids: random distinct seeding must take all six values
+  // (a plain random draw would take mostly zeros), so each ends with a
+  // centroid on it and nothing is split.
+  const std::size_t dim = 3;
+  std::vector<float> points;
+  for (int i = 0; i < 450; ++i) points.insert(points.end(), {0.0f, 0.0f, 0.0f});
+  for (int i = 0; i < 50; ++i) {
+    const float v = static_cast<float>(10 * (1 + i % 5));
+    points.insert(points.end(), {v, -v, v});
+  }
+  KMeansOptions options = SmallOptions(6);
+  options.seeding = KMeansOptions::Seeding::kRandomDistinct;
+  KMeansReport report;
+  const auto centroids = TrainKMeans(points.data(), 500, dim, options, &report);
+  ASSERT_TRUE(centroids.ok()) << centroids.status();
+  EXPECT_EQ(report.empty_clusters_split, 0u);
+  EXPECT_EQ(report.objective.front(), 0.0);
+  std::set<float> firsts;
+  for (std::size_t c = 0; c < 6; ++c) firsts.insert((*centroids)[c * dim]);
+  EXPECT_EQ(firsts, (std::set<float>{0, 10, 20, 30, 40, 50}));
 }
 
 }  // namespace

@@ -143,4 +143,58 @@ void NearestCentroidIndex::SearchImpl(const T* points,
   });
 }
 
+void NearestCentroidIndex::SearchTopK(const float* points,
+                                      std::size_t n,
+                                      std::size_t k,
+                                      uint32_t* labels,
+                                      float* scores) const {
+  k = std::min(k, num_centroids_);
+  if (k == 0 || n == 0) return;
+  const std::size_t dim = dim_;
+  const std::size_t panel_floats = dim * kPanelWidth;
+  const std::size_t num_panels = norms_.size() / kPanelWidth;
+  const std::size_t tile_panels =
+      std::max<std::size_t>(1, kTileBytes / (panel_floats * sizeof(float)));
+  // Called once per probed group and block by the approximate search (tens
+  // of thousands of times per k-means iteration), so nothing is copied or
+  // allocated per call except the last, partial row block, padded with zeros.
+  const std::size_t full_rows = n / kBlockRows * kBlockRows;
+  std::vector<float> tail;
+  if (full_rows < n) {
+    tail.assign(kBlockRows * dim, 0.0f);
+    std::copy_n(points + full_rows * dim, (n - full_rows) * dim, tail.begin());
+  }
+  std::fill_n(scores, n * k, std::numeric_limits<float>::infinity());
+  std::fill_n(labels, n * k, 0u);
+  float dots[kBlockRows][kPanelWidth];
+  for (std::size_t tile = 0; tile < num_panels; tile += tile_panels) {
+    const std::size_t tile_end = std::min(num_panels, tile + tile_panels);
+    for (std::size_t r0 = 0; r0 < n; r0 += kBlockRows) {
+      const float* x = r0 < full_rows ? points + r0 * dim : tail.data();
+      const std::size_t rows = std::min(kBlockRows, n - r0);
+      for (std::size_t p = tile; p < tile_end; ++p) {
+        PanelDots(x, dim, &packed_[p * panel_floats], dots);
+        const float* norms = &norms_[p * kPanelWidth];
+        for (std::size_t r = 0; r < rows; ++r) {
+          float* b = scores + (r0 + r) * k;
+          uint32_t* bl = labels + (r0 + r) * k;
+          for (std::size_t l = 0; l < kPanelWidth; ++l) {
+            // Same score and strict comparison as SearchImpl; a new entry
+            // goes after the equal ones, which have lower indices.
+            const float score = norms[l] - 2.0f * dots[r][l];
+            if (!(score < b[k - 1])) continue;
+            std::size_t j = k - 1;
+            for (; j > 0 && score < b[j - 1]; --j) {
+              b[j] = b[j - 1];
+              bl[j] = bl[j - 1];
+            }
+            b[j] = score;
+            bl[j] = static_cast<uint32_t>(p * kPanelWidth + l);
+          }
+        }
+      }
+    }
+  }
+}
+
 }  // namespace meshseek

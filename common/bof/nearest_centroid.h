@@ -70,6 +70,20 @@ class NearestCentroidIndex {
               uint32_t* labels,
               float* squared_distances) const;
 
+  /// The `k` nearest centroids of each of the `n` row-major float points, on
+  /// the calling thread: labels and scores are n x k, row i listing point i's
+  /// neighbours by increasing score, ties by increasing index (k is clamped to
+  /// num_centroids(); callers pass k <= num_centroids()). The score is
+  /// ||c||^2 - 2 x.c, i.e. the squared distance less ||x||^2, computed exactly
+  /// as Search() computes it, so that scores of one point against different
+  /// indexes (approximate_nearest_centroid.h) compare as Search() would, and
+  /// with k = 1 the label is Search()'s.
+  void SearchTopK(const float* points,
+                  std::size_t n,
+                  std::size_t k,
+                  uint32_t* labels,
+                  float* scores) const;
+
  private:
   template <typename T>
   void SearchImpl(const T* points,

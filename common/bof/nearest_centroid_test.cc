@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <random>
@@ -125,6 +126,57 @@ TEST(NearestCentroidIndexTest, DistancesAreOptionalAndEmptyInputIsANoOp) {
   EXPECT_EQ(labels[0], 1u);
   EXPECT_EQ(labels[1], 0u);
   index.Search(points, 0, 2, labels, nullptr);
+}
+
+// k = 1 is Search(); larger k lists the k smallest scores in order (ties by
+// index), each score being ||c||^2 - 2 x.c.
+TEST(NearestCentroidIndexTest, SearchTopKListsTheNearestInOrder) {
+  const std::size_t dim = 7, k = 203, n = 301;
+  std::vector<float> centroids = RandomFloats(k * dim, 5);
+  // Two duplicated centroids: their scores tie and the lower index comes first.
+  std::copy_n(&centroids[10 * dim], dim, &centroids[150 * dim]);
+  const std::vector<float> points = RandomFloats(n * dim, 6);
+  NearestCentroidIndex index(centroids.data(), k, dim);
+  std::vector<uint32_t> exact(n);
+  index.Search(points.data(), n, 1, exact.data(), nullptr);
+  std::vector<uint32_t> top1(n);
+  std::vector<float> score1(n);
+  index.SearchTopK(points.data(), n, 1, top1.data(), score1.data());
+  EXPECT_EQ(top1, exact);
+
+  const std::size_t top = 12;
+  std::vector<uint32_t> labels(n * top);
+  std::vector<float> scores(n * top);
+  index.SearchTopK(points.data(), n, top, labels.data(), scores.data());
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_EQ(labels[i * top], exact[i]);
+    EXPECT_EQ(scores[i * top], score1[i]);
+    for (std::size_t j = 0; j < top; ++j) {
+      const float* c = &centroids[labels[i * top + j] * dim];
+      double expected = 0.0;
+      for (std::size_t d = 0; d < dim; ++d) {
+        expected += static_cast<double>(c[d]) * c[d] - 2.0 * points[i * dim + d] * c[d];
+      }
+      EXPECT_NEAR(scores[i * top + j], expected, 1e-5);
+      if (j == 0) continue;
+      EXPECT_LE(scores[i * top + j - 1], scores[i * top + j]);
+      if (scores[i * top + j - 1] == scores[i * top + j]) {
+        EXPECT_LT(labels[i * top + j - 1], labels[i * top + j]);
+      }
+    }
+    // Nothing outside the list is nearer than its last entry.
+    std::vector<bool> listed(k, false);
+    for (std::size_t j = 0; j < top; ++j) listed[labels[i * top + j]] = true;
+    for (std::size_t c = 0; c < k; ++c) {
+      if (listed[c]) continue;
+      double s = 0.0;
+      for (std::size_t d = 0; d < dim; ++d) {
+        s += static_cast<double>(centroids[c * dim + d]) * centroids[c * dim + d] -
+             2.0 * points[i * dim + d] * centroids[c * dim + d];
+      }
+      EXPECT_GE(s, scores[i * top + top - 1] - 1e-5);
+    }
+  }
 }
 
 }  // namespace
