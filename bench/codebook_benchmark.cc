@@ -80,6 +80,8 @@ ABSL_FLAG(int, models, 1000, "synthetic models to encode");
 ABSL_FLAG(int, exact_models, 40, "of which encoded again with exact search");
 ABSL_FLAG(std::string, manifest, "", "labelled collection (experiment=collection)");
 ABSL_FLAG(std::string, probes_list, "4,8,16", "probes compared (experiment=collection, libraries)");
+ABSL_FLAG(std::string, iterations_list, "25",
+          "maximum Lloyd iterations compared (experiment=collection)");
 
 namespace meshseek {
 namespace {
@@ -487,18 +489,24 @@ int Collection() {
   for (const ManifestEntry& m : *models) labels.push_back(m.label);
 
   std::vector<std::pair<std::string, KMeansOptions>> variants;
-  KMeansOptions exact = options.kmeans;
-  exact.assignment = KMeansOptions::Assignment::kExact;
-  variants.emplace_back("exact (today's default)", exact);
-  for (int probes : ParseList(absl::GetFlag(FLAGS_probes_list))) {
-    KMeansOptions approx = options.kmeans;
-    approx.assignment = KMeansOptions::Assignment::kApproximate;
-    approx.approximate_probes = probes;
-    variants.emplace_back("approximate, " + std::to_string(probes) + " probes, random seeding",
-                          approx);
-    approx.seeding = KMeansOptions::Seeding::kKMeansPlusPlus;
-    variants.emplace_back("approximate, " + std::to_string(probes) + " probes, k-means++",
-                          approx);
+  for (int iterations : ParseList(absl::GetFlag(FLAGS_iterations_list))) {
+    KMeansOptions base = options.kmeans;
+    base.max_iterations = iterations;
+    const std::string it = ", " + std::to_string(iterations) + " it max";
+    KMeansOptions exact = base;
+    exact.assignment = KMeansOptions::Assignment::kExact;
+    exact.seeding = KMeansOptions::Seeding::kKMeansPlusPlus;
+    variants.emplace_back("exact, k-means++" + it, exact);
+    for (int probes : ParseList(absl::GetFlag(FLAGS_probes_list))) {
+      KMeansOptions approx = base;
+      approx.assignment = KMeansOptions::Assignment::kApproximate;
+      approx.approximate_probes = probes;
+      approx.seeding = KMeansOptions::Seeding::kRandomDistinct;
+      variants.emplace_back("approx " + std::to_string(probes) + " probes, random" + it, approx);
+      approx.seeding = KMeansOptions::Seeding::kKMeansPlusPlus;
+      variants.emplace_back("approx " + std::to_string(probes) + " probes, k-means++" + it,
+                            approx);
+    }
   }
   for (auto& [name, kmeans] : variants) {
     kmeans.num_threads = options.num_threads;
@@ -531,7 +539,7 @@ int Collection() {
     for (float d : d2) objective += d;
     objective /= total;
     std::printf(
-        "V = %zu, %-40s CPU s: train %6.1f (%2d it), encode %5.1f; exact objective %.1f, "
+        "V = %zu, %-44s CPU s: train %6.1f (%2d it), encode %5.1f; exact objective %.1f, "
         "FT %.1f, NN %.1f (micro, percent)\n",
         codebook->size(),
         name.c_str(),

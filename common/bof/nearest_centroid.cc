@@ -4,15 +4,15 @@
 #include <cstring>
 #include <limits>
 
+#include "common/base/cpu_features.h"
 #include "common/base/parallel.h"
 
 namespace meshseek {
 namespace {
 
-// 8 centroid lanes x 4 points = 32 accumulators: 8 SSE registers, leaving room
-// for the panel loads and the broadcasts within the 16 that x86-64 has.
-constexpr std::size_t kPanelWidth = 8;
-constexpr std::size_t kBlockRows = 4;
+// A block of 8 points against a panel of 16 centroids: 128 dot products.
+constexpr std::size_t kPanelWidth = 16;
+constexpr std::size_t kBlockRows = 8;
 // Points per ParallelFor item. Fixed, so the split never depends on the thread
 // count; large enough that a tile of centroids is reused many times.
 constexpr std::size_t kPointsPerTask = 128;
@@ -20,40 +20,94 @@ constexpr std::size_t kPointsPerTask = 128;
 // stay resident in a 512 KiB..2 MiB L2 next to the block of points.
 constexpr std::size_t kTileBytes = 256 * 1024;
 
-// Four float lanes: one SSE register at baseline x86-64. GCC and Clang lower
-// this generic vector type to whatever the target has (scalars where nothing).
-// It pins the vectorisation to the centroid lanes: GCC 12's loop vectoriser,
-// given the same kernel as plain nested loops, vectorises the dimension loop
-// instead (interleaved loads and shuffles) and runs at under a third of the
-// speed (10 against 36 GFLOP/s measured for V = 1,000, dim 128).
+// GCC/Clang generic vector types. They pin the vectorisation to the centroid
+// lanes: GCC 12's loop vectoriser, given the kernel as plain nested loops,
+// vectorises the dimension loop instead (interleaved loads and shuffles) and
+// runs at under a third of the speed (10 against 36 GFLOP/s measured for
+// V = 1,000, dim 128, SSE2).
 typedef float Float4 __attribute__((vector_size(16)));
-constexpr std::size_t kLanes = 4;
-constexpr std::size_t kVectorsPerPanel = kPanelWidth / kLanes;
+typedef float Float8 __attribute__((vector_size(32)));
+typedef float Float16 __attribute__((vector_size(64)));
+// Loads and stores go through a pointer to an unaligned, aliasing copy of the
+// type: GCC turns a std::memcpy into an array of vectors into stack round
+// trips.
+template <typename Vec>
+struct Unaligned {
+  typedef Vec type __attribute__((aligned(4), may_alias));
+};
 
-// dots[r][l] = sum over d of x[r][d] * panel[d][l], summed in increasing d.
-// `x` holds kBlockRows rows of `dim` floats; `panel` is dim x kPanelWidth.
-inline void PanelDots(const float* x,
-                      std::size_t dim,
-                      const float* panel,
-                      float dots[kBlockRows][kPanelWidth]) {
-  Float4 acc[kBlockRows][kVectorsPerPanel] = {};
-  for (std::size_t d = 0; d < dim; ++d) {
-    Float4 p[kVectorsPerPanel];
-    std::memcpy(p, panel + d * kPanelWidth, sizeof(p));
-    for (std::size_t r = 0; r < kBlockRows; ++r) {
-      const float xv = x[r * dim + d];
-      for (std::size_t v = 0; v < kVectorsPerPanel; ++v) acc[r][v] += xv * p[v];
+// dots[r][l] = sum over d of x[r][d] * panel[d][l], summed in increasing d,
+// for the kBlockRows rows of `x` (each `dim` floats) and the kPanelWidth
+// centroids of `panel` (dim x kPanelWidth). `Vec` holds some of a panel's
+// lanes; kRows rows are done per pass, so that the pass's accumulators
+// (kRows x lanes per Vec) fit the registers of the target. Every lane does the
+// same multiply and add as every other variant, in the same order.
+template <typename Vec, std::size_t kRows>
+__attribute__((always_inline)) inline void PanelDotsBody(const float* x,
+                                                         std::size_t dim,
+                                                         const float* panel,
+                                                         float* dots) {
+  constexpr std::size_t kLanes = sizeof(Vec) / sizeof(float);
+  constexpr std::size_t kVectors = kPanelWidth / kLanes;
+  for (std::size_t r0 = 0; r0 < kBlockRows; r0 += kRows) {
+    Vec acc[kRows][kVectors] = {};
+    for (std::size_t d = 0; d < dim; ++d) {
+      const auto* p = reinterpret_cast<const typename Unaligned<Vec>::type*>(panel + d * kPanelWidth);
+      for (std::size_t r = 0; r < kRows; ++r) {
+        const float xv = x[(r0 + r) * dim + d];
+        for (std::size_t v = 0; v < kVectors; ++v) acc[r][v] += xv * p[v];
+      }
+    }
+    for (std::size_t r = 0; r < kRows; ++r) {
+      for (std::size_t v = 0; v < kVectors; ++v) {
+        *reinterpret_cast<typename Unaligned<Vec>::type*>(dots + (r0 + r) * kPanelWidth +
+                                                          v * kLanes) = acc[r][v];
+      }
     }
   }
-  std::memcpy(dots, acc, sizeof(acc));
+}
+
+// The variants: 2 x 4 SSE registers of accumulators, 4 x 2 AVX2 ones, 8 x 1
+// AVX-512 ones (of 16, 16 and 32 registers).
+void PanelDotsSse2(const float* x, std::size_t dim, const float* panel, float* dots) {
+  PanelDotsBody<Float4, 2>(x, dim, panel, dots);
+}
+#if defined(__x86_64__)
+__attribute__((target("avx2"))) void PanelDotsAvx2(const float* x,
+                                                   std::size_t dim,
+                                                   const float* panel,
+                                                   float* dots) {
+  PanelDotsBody<Float8, 4>(x, dim, panel, dots);
+}
+__attribute__((target("avx512f"))) void PanelDotsAvx512(const float* x,
+                                                       std::size_t dim,
+                                                       const float* panel,
+                                                       float* dots) {
+  PanelDotsBody<Float16, 8>(x, dim, panel, dots);
+}
+#endif
+
+using PanelDotsFn = void (*)(const float*, std::size_t, const float*, float*);
+
+PanelDotsFn PanelDotsFor(SimdLevel level) {
+#if defined(__x86_64__)
+  if (level == SimdLevel::kAvx512) return PanelDotsAvx512;
+  if (level == SimdLevel::kAvx2) return PanelDotsAvx2;
+#endif
+  (void)level;
+  return PanelDotsSse2;
 }
 
 }  // namespace
 
 NearestCentroidIndex::NearestCentroidIndex(const float* centroids,
                                            std::size_t num_centroids,
-                                           std::size_t dim)
-    : num_centroids_(num_centroids), dim_(dim) {
+                                           std::size_t dim,
+                                           SimdLevel simd)
+    : num_centroids_(num_centroids),
+      dim_(dim),
+      simd_(static_cast<int>(simd) < static_cast<int>(DetectedSimdLevel()) ? simd
+                                                                          : DetectedSimdLevel()) {
   const std::size_t panels = (num_centroids + kPanelWidth - 1) / kPanelWidth;
   packed_.assign(panels * dim * kPanelWidth, 0.0f);
   norms_.assign(panels * kPanelWidth, std::numeric_limits<float>::infinity());
@@ -97,6 +151,7 @@ void NearestCentroidIndex::SearchImpl(const T* points,
   const std::size_t tile_panels =
       std::max<std::size_t>(1, kTileBytes / (panel_floats * sizeof(float)));
   const std::size_t num_tasks = (n + kPointsPerTask - 1) / kPointsPerTask;
+  const PanelDotsFn panel_dots = PanelDotsFor(simd_);
 
   ParallelFor(num_tasks, num_threads, [&](std::size_t task) {
     const std::size_t begin = task * kPointsPerTask;
@@ -115,7 +170,7 @@ void NearestCentroidIndex::SearchImpl(const T* points,
       const std::size_t tile_end = std::min(num_panels, tile + tile_panels);
       for (std::size_t r0 = 0; r0 < rows; r0 += kBlockRows) {
         for (std::size_t p = tile; p < tile_end; ++p) {
-          PanelDots(&x[r0 * dim], dim, &packed_[p * panel_floats], dots);
+          panel_dots(&x[r0 * dim], dim, &packed_[p * panel_floats], &dots[0][0]);
           const float* norms = &norms_[p * kPanelWidth];
           for (std::size_t r = 0; r < kBlockRows; ++r) {
             for (std::size_t l = 0; l < kPanelWidth; ++l) {
@@ -158,6 +213,7 @@ void NearestCentroidIndex::SearchTopK(const float* points,
   // Called once per probed group and block by the approximate search (tens
   // of thousands of times per k-means iteration), so nothing is copied or
   // allocated per call except the last, partial row block, padded with zeros.
+  const PanelDotsFn panel_dots = PanelDotsFor(simd_);
   const std::size_t full_rows = n / kBlockRows * kBlockRows;
   std::vector<float> tail;
   if (full_rows < n) {
@@ -173,7 +229,7 @@ void NearestCentroidIndex::SearchTopK(const float* points,
       const float* x = r0 < full_rows ? points + r0 * dim : tail.data();
       const std::size_t rows = std::min(kBlockRows, n - r0);
       for (std::size_t p = tile; p < tile_end; ++p) {
-        PanelDots(x, dim, &packed_[p * panel_floats], dots);
+        panel_dots(x, dim, &packed_[p * panel_floats], &dots[0][0]);
         const float* norms = &norms_[p * kPanelWidth];
         for (std::size_t r = 0; r < rows; ++r) {
           float* b = scores + (r0 + r) * k;

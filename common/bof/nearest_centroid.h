@@ -7,22 +7,24 @@
 // Method. ||x - c||^2 = ||x||^2 - 2 x.c + ||c||^2, and the argmin over c needs
 // only ||c||^2 - 2 x.c, so the search is a points-by-centroids matrix product
 // with a running minimum (as in Faiss's exhaustive L2 search). The product is a
-// register-blocked kernel: centroids are packed in panels of 8, dimension-major,
-// and for each dimension 4 point values are each multiplied by the 8 contiguous
-// centroid values of the panel. It is portable C++ on GCC/Clang generic vector
-// types of 4 floats (one SSE2 register at baseline x86-64): no -march flag, no
-// intrinsics (nearest_centroid.cc says why not plain loops). Centroids are
-// visited in cache-sized tiles so that the packed tile stays in L2 while a block
-// of points is searched against it. 36 GFLOP/s on one core of the development
-// machine (AMD EPYC).
+// register-blocked kernel: centroids are packed in panels of 16,
+// dimension-major, and for each dimension 8 point values are each multiplied by
+// the 16 contiguous centroid values of the panel. It is portable C++ on
+// GCC/Clang generic vector types (nearest_centroid.cc says why not plain
+// loops), compiled for baseline x86-64 (SSE2) and, chosen at run time
+// (cpu_features.h), for AVX2 and AVX-512. Centroids are visited in cache-sized
+// tiles so that the packed tile stays in L2 while a block of points is
+// searched against it. On one core of the development machines:
+// bench/results/codebook.txt.
 //
 // Determinism. Vectorising across centroids, not across dimensions, means every
 // dot product x.c is summed in the order d = 0, 1, ..., dim - 1 whatever the
 // blocking, the vector width or the thread count; ties go to the lowest centroid
 // index. Points are split into fixed blocks that do not depend on the thread
-// count. Results are therefore bit-identical for any num_threads. The module is
-// compiled with -ffp-contract=off so that no compiler fuses a multiply-add on
-// hardware with FMA, which would change the rounding.
+// count. Results are therefore bit-identical for any num_threads and on any
+// machine, whichever variant runs (a test pins it). The module is compiled with
+// -ffp-contract=off so that no variant fuses a multiply-add on hardware with
+// FMA, which would change the rounding.
 //
 // Accuracy. The expansion loses relative precision when ||x - c||^2 is much
 // smaller than ||x||^2. For SIFT descriptors (norm about 512, squared distances
@@ -36,6 +38,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/base/cpu_features.h"
+
 namespace meshseek {
 
 // Immutable once built; Search() may be called from several threads at once.
@@ -46,11 +50,18 @@ class NearestCentroidIndex {
 
   /// Copies and packs `num_centroids` x `dim` row-major centroids. The caller
   /// has checked the input (kmeans.cc and codebook.cc do): num_centroids >= 1
-  /// and < 2^32, dim >= 1, all values finite.
-  NearestCentroidIndex(const float* centroids, std::size_t num_centroids, std::size_t dim);
+  /// and < 2^32, dim >= 1, all values finite. `simd` selects the kernel
+  /// variant (capped at what the CPU has); only tests and benchmarks that
+  /// compare the variants pass it, the results being the same.
+  NearestCentroidIndex(const float* centroids,
+                       std::size_t num_centroids,
+                       std::size_t dim,
+                       SimdLevel simd = DetectedSimdLevel());
 
   std::size_t num_centroids() const { return num_centroids_; }
   std::size_t dim() const { return dim_; }
+  /// The kernel variant this index runs.
+  SimdLevel simd() const { return simd_; }
 
   /// For each of the `n` row-major points (n x dim), writes the index of the
   /// nearest centroid to labels[i] and, when `squared_distances` is not null,
@@ -94,7 +105,8 @@ class NearestCentroidIndex {
 
   std::size_t num_centroids_ = 0;
   std::size_t dim_ = 0;
-  // Panels of 8 centroids, each dim x 8 floats (dimension-major); the last
+  SimdLevel simd_ = SimdLevel::kSse2;
+  // Panels of 16 centroids, each dim x 16 floats (dimension-major); the last
   // panel is padded with zero centroids whose norm is +inf so they never win.
   std::vector<float> packed_;
   // ||c||^2 per padded centroid.

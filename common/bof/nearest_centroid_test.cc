@@ -179,5 +179,41 @@ TEST(NearestCentroidIndexTest, SearchTopKListsTheNearestInOrder) {
   }
 }
 
+// Every kernel variant this CPU can run (SSE2 always; AVX2 and AVX-512 where
+// present) gives the same bits: labels, distances and top-k scores, on sizes
+// that leave remainders of the 8-row blocks, 16-lane panels and tiles.
+TEST(NearestCentroidIndexTest, EveryKernelVariantGivesTheSameBits) {
+  const std::size_t k = 2003, n = 517, dim = 128, top = 5;
+  std::mt19937 rng(7);
+  std::vector<uint8_t> points(n * dim);
+  for (uint8_t& v : points) v = static_cast<uint8_t>(rng() % 64);
+  std::vector<float> centroids = RandomFloats(k * dim, 8);
+  for (float& c : centroids) c = 32.0f + 32.0f * c;
+  std::vector<float> float_points(points.begin(), points.end());
+  const SimdLevel levels[] = {SimdLevel::kSse2, SimdLevel::kAvx2, SimdLevel::kAvx512};
+  std::vector<uint32_t> labels[3], top_labels[3];
+  std::vector<float> distances[3], top_scores[3];
+  for (int v = 0; v < 3; ++v) {
+    const NearestCentroidIndex index(centroids.data(), k, dim, levels[v]);
+    if (index.simd() != levels[v]) {
+      EXPECT_LT(static_cast<int>(DetectedSimdLevel()), v) << "variant " << v << " not taken";
+      labels[v] = labels[0], distances[v] = distances[0];
+      top_labels[v] = top_labels[0], top_scores[v] = top_scores[0];
+      continue;
+    }
+    labels[v].resize(n);
+    distances[v].resize(n);
+    index.Search(points.data(), n, 2, labels[v].data(), distances[v].data());
+    top_labels[v].resize(n * top);
+    top_scores[v].resize(n * top);
+    index.SearchTopK(float_points.data(), n, top, top_labels[v].data(), top_scores[v].data());
+    if (v == 0) continue;
+    EXPECT_EQ(labels[v], labels[0]) << SimdLevelName(levels[v]);
+    EXPECT_EQ(distances[v], distances[0]) << SimdLevelName(levels[v]);
+    EXPECT_EQ(top_labels[v], top_labels[0]) << SimdLevelName(levels[v]);
+    EXPECT_EQ(top_scores[v], top_scores[0]) << SimdLevelName(levels[v]);
+  }
+}
+
 }  // namespace
 }  // namespace meshseek
