@@ -35,6 +35,9 @@ ABSL_FLAG(std::string, collection, "",
           "collection name (eval: default <manifest folder>-<method>-<parameter hash>)");
 ABSL_FLAG(std::string, folder, "", "ingest: every mesh file in this folder (id = file name)");
 ABSL_FLAG(int, top_k, 10, "query: results to print");
+ABSL_FLAG(int, candidates, 0,
+          "query: 0 searches exactly; N re-ranks the N candidates an embedding proposes "
+          "(faster on large collections, may miss a neighbour)");
 ABSL_FLAG(std::string, job, "", "status: a job id to follow until it ends");
 ABSL_FLAG(int, port, 50051, "serve: coordinator port of the embedded stack");
 ABSL_FLAG(absl::Duration, reconnect_for, absl::Minutes(2),
@@ -49,7 +52,8 @@ ABSL_DECLARE_FLAG(int, threads);
 namespace meshseek::cli {
 namespace {
 
-// Guards the ingest stream's map of unacknowledged models.
+// Guards the ingest stream's map of unacknowledged models and the
+// acknowledgement flags the reader thread sets.
 absl::Mutex sent_mutex_;
 
 // A coordinator to talk to: the given --server or an embedded stack.
@@ -198,7 +202,12 @@ absl::Status IngestModels(v1::Coordinator::Stub* stub, const std::string& collec
       }
     });
     for (std::size_t i = 0; i < models.size(); ++i) {
-      if (acked[i]) continue;
+      {
+        // The reader thread sets acknowledgements (vector<bool> packs them
+        // into shared words: every access under the mutex).
+        absl::MutexLock lock(&sent_mutex_);
+        if (acked[i]) continue;
+      }
       const ModelToIngest& m = models[i];
       absl::StatusOr<TriangleMesh> mesh = ReadMesh(m.path);
       if (!mesh.ok()) {
@@ -285,6 +294,7 @@ absl::Status RunQuery(const std::string& model_path) {
   v1::QueryRequest request;
   request.set_collection(collection);
   request.set_top_k(absl::GetFlag(FLAGS_top_k));
+  request.set_candidates(absl::GetFlag(FLAGS_candidates));
   rpc::MeshToProto(mesh, request.mutable_mesh()->mutable_mesh());
   v1::QueryResponse response;
   MESHSEEK_RETURN_IF_ERROR(Call(session->stub(), &v1::Coordinator::Stub::Query, request, &response,

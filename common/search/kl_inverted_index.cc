@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <utility>
 
+#include "absl/base/casts.h"
 #include "absl/strings/str_cat.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
@@ -13,18 +15,28 @@ namespace meshseek {
 namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
+// Distinct weights one segment can name with a 16-bit value id.
+constexpr std::size_t kMaxValues = 1 << 16;
 
-// The two common sums of one model against the query (a_xy, a_yx).
-struct CommonSums {
-  double query_side = 0.0;  // sum x_k g(y_k), x the query
-  double model_side = 0.0;  // sum y_k g(x_k)
-};
+// Two doubles and two floats as GCC/Clang generic vectors: one SSE register
+// and half of one at baseline x86-64 (NEON on aarch64). The scan adds both
+// common sums of a posting with one packed multiply and add; each lane does
+// exactly the scalar operation, so the sums are the same bits.
+typedef double Double2 __attribute__((vector_size(16)));
+typedef float Float2 __attribute__((vector_size(8)));
+
+// The two common sums of one model against the query: lane 0 the query side
+// a_xy = sum x_k g(y_k) (x the query), lane 1 the model side a_yx = sum y_k g(x_k).
+using CommonSums = Double2;
 
 // Scratch of one thread: the common sums of a segment's slots.
 std::vector<CommonSums>& Scratch() {
   thread_local std::vector<CommonSums> scratch;
   return scratch;
 }
+
+// The embedding's fixed seed: its axes are a function of the sample alone.
+constexpr uint64_t kEmbeddingSeed = 0x6d657368u;  // "mesh"
 
 bool Closer(const KlNeighbor& a, const KlNeighbor& b) {
   return a.distance < b.distance || (a.distance == b.distance && a.doc < b.doc);
@@ -37,18 +49,92 @@ struct KlInvertedIndex::PreparedQuery {
   std::vector<float> weights;
   std::vector<float> g;  // float-rounded g(weight)
   double c = 0.0, e = 0.0, a = 0.0, big_g = 0.0;
+  // sum_k sqrt(x_k) P[word_k] and its squared norm.
+  std::vector<float> embedding;
+  float embedding_norm = 0.0f;
   bool empty() const { return words.empty(); }
 };
 
 struct KlInvertedIndex::Segment {
+  // Per word, the postings of the segment's models: slot and value id.
   struct Postings {
     std::vector<uint16_t> slots;
-    std::vector<float> weights;
-    std::vector<float> g;
+    std::vector<uint16_t> values;
   };
   explicit Segment(uint32_t vocabulary) : postings(vocabulary) {}
 
+  // Value id of `weight` (with its g), added to the dictionary if new.
+  uint16_t ValueOf(float weight, float g) {
+    auto [it, inserted] =
+        value_ids.try_emplace(absl::bit_cast<uint32_t>(weight), static_cast<uint16_t>(values.size()));
+    if (inserted) values.push_back(Float2{g, weight});
+    return it->second;
+  }
+  // Whether `q`'s weights fit the dictionary.
+  bool Fits(const PreparedQuery& q) const {
+    std::size_t fresh = 0;
+    for (float w : q.weights) fresh += !value_ids.contains(absl::bit_cast<uint32_t>(w));
+    return values.size() + fresh <= kMaxValues;
+  }
+
+  // Adds a model at the next slot: postings, forward entries, constants.
+  void Add(uint32_t doc, const PreparedQuery& q) {
+    const auto slot = static_cast<uint16_t>(docs.size());
+    for (std::size_t i = 0; i < q.words.size(); ++i) {
+      const uint16_t value = ValueOf(q.weights[i], q.g[i]);
+      Postings& p = postings[q.words[i]];
+      p.slots.push_back(slot);
+      p.values.push_back(value);
+      forward_words.push_back(static_cast<uint16_t>(q.words[i]));
+      forward_values.push_back(value);
+    }
+    forward_end.push_back(forward_words.size());
+    if (!q.embedding.empty()) {
+      embeddings.insert(embeddings.end(), q.embedding.begin(), q.embedding.end());
+      embedding_norms.push_back(q.embedding_norm);
+    }
+    docs.push_back(doc);
+    live.push_back(1);
+    empty.push_back(q.empty() ? 1 : 0);
+    c.push_back(q.c);
+    e.push_back(q.e);
+    a.push_back(q.a);
+    big_g.push_back(q.big_g);
+  }
+  // The histogram at `slot` (as given) with its prepared constants.
+  PreparedQuery Stored(std::size_t slot) const {
+    PreparedQuery q;
+    for (std::size_t i = slot == 0 ? 0 : forward_end[slot - 1]; i < forward_end[slot]; ++i) {
+      q.words.push_back(forward_words[i]);
+      q.weights.push_back(values[forward_values[i]][1]);
+      q.g.push_back(values[forward_values[i]][0]);
+    }
+    q.c = c[slot];
+    q.e = e[slot];
+    q.a = a[slot];
+    q.big_g = big_g[slot];
+    if (slot < embedding_norms.size()) {  // once the index has an embedding
+      const std::size_t d = KlInvertedIndex::kEmbeddingDimensions;
+      q.embedding.assign(embeddings.begin() + slot * d, embeddings.begin() + (slot + 1) * d);
+      q.embedding_norm = embedding_norms[slot];
+    }
+    return q;
+  }
+
   std::vector<Postings> postings;  // per word
+  // Per slot, its words and value ids in word order (the forward index, for
+  // exact distances to a few candidates): entries [forward_end[slot - 1],
+  // forward_end[slot]).
+  std::vector<uint16_t> forward_words;
+  std::vector<uint16_t> forward_values;
+  std::vector<std::size_t> forward_end;
+  // Per slot, kEmbeddingDimensions floats and their squared norm.
+  std::vector<float> embeddings;
+  std::vector<float> embedding_norms;
+  // The value dictionary: per value id its float-rounded g and the weight,
+  // side by side so that a posting loads both at once.
+  std::vector<Float2> values;
+  absl::flat_hash_map<uint32_t, uint16_t> value_ids;  // weight's bits -> id
   // Per slot.
   std::vector<uint32_t> docs;
   std::vector<uint8_t> live;
@@ -58,9 +144,7 @@ struct KlInvertedIndex::Segment {
 };
 
 KlInvertedIndex::KlInvertedIndex(uint32_t vocabulary, const KlDivergenceOptions& options)
-    : vocabulary_(vocabulary),
-      options_(options),
-      scale_(1.0 / (1.0 + vocabulary * options.epsilon)) {}
+    : vocabulary_(vocabulary), options_(options) {}
 KlInvertedIndex::KlInvertedIndex(KlInvertedIndex&&) noexcept = default;
 KlInvertedIndex& KlInvertedIndex::operator=(KlInvertedIndex&&) noexcept = default;
 KlInvertedIndex::~KlInvertedIndex() = default;
@@ -68,7 +152,10 @@ KlInvertedIndex::~KlInvertedIndex() = default;
 absl::StatusOr<KlInvertedIndex> KlInvertedIndex::Create(uint32_t vocabulary,
                                                         const KlDivergenceOptions& options) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
-  if (vocabulary == 0) return absl::InvalidArgumentError("KlInvertedIndex: vocabulary 0");
+  if (vocabulary == 0 || vocabulary > kMaxVocabulary) {
+    return absl::InvalidArgumentError(absl::StrCat("KlInvertedIndex: vocabulary ", vocabulary,
+                                                   " is not in [1, ", kMaxVocabulary, "]"));
+  }
   return KlInvertedIndex(vocabulary, options);
 }
 
@@ -92,31 +179,52 @@ absl::StatusOr<KlInvertedIndex::PreparedQuery> KlInvertedIndex::Prepare(
     q.a += x * static_cast<double>(q.g[i]);
     q.big_g += q.g[i];
   }
+  if (embedding_) Embed(&q);
   q.c = 1.0 / (sum + vocabulary_ * eps);
   q.e = eps * q.c;
   return q;
 }
 
 void KlInvertedIndex::Append(uint32_t doc, const PreparedQuery& q) {
-  if (segments_.empty() || segments_.back()->docs.size() == kSegmentSlots) {
+  if (segments_.empty() || segments_.back()->docs.size() == kSegmentSlots ||
+      !segments_.back()->Fits(q)) {
     segments_.push_back(std::make_unique<Segment>(vocabulary_));
   }
   Segment& seg = *segments_.back();
-  const auto slot = static_cast<uint16_t>(seg.docs.size());
-  for (std::size_t i = 0; i < q.words.size(); ++i) {
-    Segment::Postings& p = seg.postings[q.words[i]];
-    p.slots.push_back(slot);
-    p.weights.push_back(q.weights[i]);
-    p.g.push_back(q.g[i]);
+  locations_[doc] =
+      Location{static_cast<uint32_t>(segments_.size() - 1), static_cast<uint16_t>(seg.docs.size())};
+  seg.Add(doc, q);
+  if (!embedding_ && size() >= kEmbeddingFitModels) FitEmbedding();
+}
+
+void KlInvertedIndex::Embed(PreparedQuery* q) const {
+  q->embedding.resize(kEmbeddingDimensions);
+  embedding_->Embed(q->words, q->weights, q->embedding.data());
+  q->embedding_norm = 0.0f;
+  for (float v : q->embedding) q->embedding_norm += v * v;
+}
+
+void KlInvertedIndex::FitEmbedding() {
+  // The sample: every live model, in segment and slot order (insertion
+  // order, up to compactions).
+  std::vector<SparseHistogram> sample;
+  sample.reserve(size());
+  ForEach([&](uint32_t, const SparseHistogram& h) { sample.push_back(h); });
+  absl::StatusOr<HistogramEmbedding> fitted = HistogramEmbedding::Fit(
+      sample, vocabulary_, static_cast<int>(kEmbeddingDimensions), kEmbeddingSeed);
+  if (!fitted.ok()) return;  // cannot happen for stored (valid) histograms: stay exact
+  embedding_ = *std::move(fitted);
+  for (const auto& seg : segments_) {
+    seg->embeddings.assign(seg->docs.size() * kEmbeddingDimensions, 0.0f);
+    seg->embedding_norms.assign(seg->docs.size(), 0.0f);
+    for (std::size_t slot = 0; slot < seg->docs.size(); ++slot) {
+      PreparedQuery q = seg->Stored(slot);
+      Embed(&q);
+      std::copy(q.embedding.begin(), q.embedding.end(),
+                seg->embeddings.begin() + slot * kEmbeddingDimensions);
+      seg->embedding_norms[slot] = q.embedding_norm;
+    }
   }
-  seg.docs.push_back(doc);
-  seg.live.push_back(1);
-  seg.empty.push_back(q.empty() ? 1 : 0);
-  seg.c.push_back(q.c);
-  seg.e.push_back(q.e);
-  seg.a.push_back(q.a);
-  seg.big_g.push_back(q.big_g);
-  locations_[doc] = Location{static_cast<uint32_t>(segments_.size() - 1), slot};
 }
 
 absl::Status KlInvertedIndex::Upsert(uint32_t doc, const SparseHistogram& histogram) {
@@ -139,57 +247,40 @@ bool KlInvertedIndex::Remove(uint32_t doc) {
   return true;
 }
 
-std::vector<SparseHistogram> KlInvertedIndex::SegmentHistograms(std::size_t s) const {
-  const Segment& seg = *segments_[s];
-  std::vector<SparseHistogram> histograms(seg.docs.size());
-  for (SparseHistogram& h : histograms) h.vocabulary = vocabulary_;
-  for (uint32_t word = 0; word < vocabulary_; ++word) {
-    const Segment::Postings& p = seg.postings[word];
-    for (std::size_t i = 0; i < p.slots.size(); ++i) {
-      histograms[p.slots[i]].words.push_back(word);
-      histograms[p.slots[i]].weights.push_back(p.weights[i]);
-    }
-  }
-  return histograms;
-}
-
 void KlInvertedIndex::CompactSegment(std::size_t s) {
-  // Rebuilds segment s from its live slots, in slot order; slots change, docs
-  // and values do not. The rebuilt segment replaces s in place.
-  const std::vector<SparseHistogram> histograms = SegmentHistograms(s);
+  // Rebuilds segment s from its live slots, in slot order: slots change,
+  // docs and values do not. The rebuilt segment replaces s in place.
   const Segment& old = *segments_[s];
   auto rebuilt = std::make_unique<Segment>(vocabulary_);
   for (std::size_t slot = 0; slot < old.docs.size(); ++slot) {
     if (!old.live[slot]) continue;
-    const auto fresh = static_cast<uint16_t>(rebuilt->docs.size());
-    const SparseHistogram& h = histograms[slot];
-    for (std::size_t i = 0; i < h.words.size(); ++i) {
-      const Segment::Postings& from = old.postings[h.words[i]];
-      Segment::Postings& to = rebuilt->postings[h.words[i]];
-      // The g stored for this posting: find it again (postings are in slot order).
-      const auto at = std::lower_bound(from.slots.begin(), from.slots.end(), slot);
-      to.slots.push_back(fresh);
-      to.weights.push_back(h.weights[i]);
-      to.g.push_back(from.g[at - from.slots.begin()]);
-    }
-    rebuilt->docs.push_back(old.docs[slot]);
-    rebuilt->live.push_back(1);
-    rebuilt->empty.push_back(old.empty[slot]);
-    rebuilt->c.push_back(old.c[slot]);
-    rebuilt->e.push_back(old.e[slot]);
-    rebuilt->a.push_back(old.a[slot]);
-    rebuilt->big_g.push_back(old.big_g[slot]);
-    locations_[old.docs[slot]] = Location{static_cast<uint32_t>(s), fresh};
+    locations_[old.docs[slot]] =
+        Location{static_cast<uint32_t>(s), static_cast<uint16_t>(rebuilt->docs.size())};
+    rebuilt->Add(old.docs[slot], old.Stored(slot));
   }
   segments_[s] = std::move(rebuilt);
 }
 
+namespace {
+
+SparseHistogram ToHistogram(uint32_t vocabulary, std::vector<uint32_t> words,
+                            std::vector<float> weights) {
+  SparseHistogram h;
+  h.vocabulary = vocabulary;
+  h.words = std::move(words);
+  h.weights = std::move(weights);
+  return h;
+}
+
+}  // namespace
+
 void KlInvertedIndex::ForEach(
     const std::function<void(uint32_t, const SparseHistogram&)>& fn) const {
-  for (std::size_t s = 0; s < segments_.size(); ++s) {
-    const std::vector<SparseHistogram> histograms = SegmentHistograms(s);
-    for (std::size_t slot = 0; slot < histograms.size(); ++slot) {
-      if (segments_[s]->live[slot]) fn(segments_[s]->docs[slot], histograms[slot]);
+  for (const auto& seg : segments_) {
+    for (std::size_t slot = 0; slot < seg->docs.size(); ++slot) {
+      if (!seg->live[slot]) continue;
+      PreparedQuery q = seg->Stored(slot);
+      fn(seg->docs[slot], ToHistogram(vocabulary_, std::move(q.words), std::move(q.weights)));
     }
   }
 }
@@ -199,18 +290,17 @@ absl::StatusOr<SparseHistogram> KlInvertedIndex::Histogram(uint32_t doc) const {
   if (it == locations_.end()) {
     return absl::NotFoundError(absl::StrCat("model ", doc, " is not in the index"));
   }
-  const Segment& seg = *segments_[it->second.segment];
-  const uint16_t slot = it->second.slot;
-  SparseHistogram h;
-  h.vocabulary = vocabulary_;
-  for (uint32_t word = 0; word < vocabulary_; ++word) {
-    const Segment::Postings& p = seg.postings[word];
-    const auto at = std::lower_bound(p.slots.begin(), p.slots.end(), slot);
-    if (at == p.slots.end() || *at != slot) continue;
-    h.words.push_back(word);
-    h.weights.push_back(p.weights[at - p.slots.begin()]);
-  }
-  return h;
+  PreparedQuery q = segments_[it->second.segment]->Stored(it->second.slot);
+  return ToHistogram(vocabulary_, std::move(q.words), std::move(q.weights));
+}
+
+double KlInvertedIndex::Combine(const PreparedQuery& q,
+                                const Segment& seg,
+                                std::size_t slot,
+                                double query_side,
+                                double model_side) {
+  return q.c * (q.a - query_side) + seg.c[slot] * (seg.a[slot] - model_side) +
+         (q.e - seg.e[slot]) * (q.big_g - seg.big_g[slot]);
 }
 
 template <typename Emit>
@@ -224,19 +314,29 @@ void KlInvertedIndex::ScanSegment(const PreparedQuery& q, std::size_t s, Emit&& 
     return;
   }
   std::vector<CommonSums>& sums = Scratch();
-  sums.assign(n, CommonSums{});
+  sums.assign(n, CommonSums{0.0, 0.0});
+  const Float2* values = seg.values.data();
+  CommonSums* sum = sums.data();
   for (std::size_t i = 0; i < q.words.size(); ++i) {
     const Segment::Postings& p = seg.postings[q.words[i]];
-    const double x = q.weights[i];
-    const double gx = q.g[i];
+    // (x, g(x)) of the query word: lane 0 multiplies the model's g, lane 1
+    // its weight. Both products of floats are exact in double.
+    const Double2 factor{static_cast<double>(q.weights[i]), static_cast<double>(q.g[i])};
     const uint16_t* slots = p.slots.data();
-    const float* weights = p.weights.data();
-    const float* g = p.g.data();
-    for (std::size_t j = 0, m = p.slots.size(); j < m; ++j) {
-      CommonSums& sum = sums[slots[j]];
-      sum.query_side += x * static_cast<double>(g[j]);
-      sum.model_side += static_cast<double>(weights[j]) * gx;
+    const uint16_t* ids = p.values.data();
+    const std::size_t m = p.slots.size();
+    std::size_t j = 0;
+    for (; j + 4 <= m; j += 4) {  // four independent slots at a time
+      const Double2 v0 = __builtin_convertvector(values[ids[j]], Double2) * factor;
+      const Double2 v1 = __builtin_convertvector(values[ids[j + 1]], Double2) * factor;
+      const Double2 v2 = __builtin_convertvector(values[ids[j + 2]], Double2) * factor;
+      const Double2 v3 = __builtin_convertvector(values[ids[j + 3]], Double2) * factor;
+      sum[slots[j]] += v0;
+      sum[slots[j + 1]] += v1;
+      sum[slots[j + 2]] += v2;
+      sum[slots[j + 3]] += v3;
     }
+    for (; j < m; ++j) sum[slots[j]] += __builtin_convertvector(values[ids[j]], Double2) * factor;
   }
   for (std::size_t slot = 0; slot < n; ++slot) {
     if (!seg.live[slot]) continue;
@@ -244,9 +344,7 @@ void KlInvertedIndex::ScanSegment(const PreparedQuery& q, std::size_t s, Emit&& 
       emit(seg.docs[slot], kInfinity);
       continue;
     }
-    const double d = q.c * (q.a - sums[slot].query_side) +
-                     seg.c[slot] * (seg.a[slot] - sums[slot].model_side) +
-                     (q.e - seg.e[slot]) * (q.big_g - seg.big_g[slot]);
+    const double d = Combine(q, seg, slot, sums[slot][0], sums[slot][1]);
     emit(seg.docs[slot], d > 0.0 ? static_cast<float>(d) : 0.0f);
   }
 }
@@ -254,6 +352,11 @@ void KlInvertedIndex::ScanSegment(const PreparedQuery& q, std::size_t s, Emit&& 
 absl::StatusOr<std::vector<KlNeighbor>> KlInvertedIndex::Distances(const SparseHistogram& query,
                                                                    int num_threads) const {
   MESHSEEK_ASSIGN_OR_RETURN(const PreparedQuery q, Prepare(query, "query"));
+  return AllDistances(q, num_threads);
+}
+
+std::vector<KlNeighbor> KlInvertedIndex::AllDistances(const PreparedQuery& q,
+                                                      int num_threads) const {
   // Each segment writes its own range of the output: segment s starts after
   // the live models of segments before it.
   std::vector<std::size_t> offsets(segments_.size() + 1, 0);
@@ -268,11 +371,93 @@ absl::StatusOr<std::vector<KlNeighbor>> KlInvertedIndex::Distances(const SparseH
   return out;
 }
 
+std::vector<KlNeighbor> KlInvertedIndex::RerankCandidates(const PreparedQuery& q,
+                                                          std::size_t candidates,
+                                                          int num_threads) const {
+  // 1. The embedding's nearest non-empty models, per segment then overall.
+  struct Proposal {
+    float distance;
+    uint32_t segment;
+    uint16_t slot;
+  };
+  const auto nearer = [](const Proposal& a, const Proposal& b) {
+    return std::tie(a.distance, a.segment, a.slot) < std::tie(b.distance, b.segment, b.slot);
+  };
+  const std::size_t d = kEmbeddingDimensions;
+  std::vector<std::vector<Proposal>> per_segment(segments_.size());
+  ParallelFor(segments_.size(), num_threads, [&](std::size_t s) {
+    const Segment& seg = *segments_[s];
+    std::vector<Proposal>& out = per_segment[s];
+    for (std::size_t slot = 0; slot < seg.docs.size(); ++slot) {
+      if (!seg.live[slot] || seg.empty[slot]) continue;
+      const float* e = &seg.embeddings[slot * d];
+      float dot[8] = {};
+      for (std::size_t j = 0; j < d; j += 8) {
+        for (std::size_t l = 0; l < 8; ++l) dot[l] += q.embedding[j + l] * e[j + l];
+      }
+      const float product = ((dot[0] + dot[1]) + (dot[2] + dot[3])) + ((dot[4] + dot[5]) + (dot[6] + dot[7]));
+      out.push_back({q.embedding_norm + seg.embedding_norms[slot] - 2.0f * product,
+                     static_cast<uint32_t>(s), static_cast<uint16_t>(slot)});
+    }
+    if (out.size() > candidates) {
+      std::nth_element(out.begin(), out.begin() + (candidates - 1), out.end(), nearer);
+      out.resize(candidates);
+    }
+  });
+  std::vector<Proposal> proposals;
+  for (const auto& part : per_segment) proposals.insert(proposals.end(), part.begin(), part.end());
+  if (proposals.size() > candidates) {
+    std::nth_element(proposals.begin(), proposals.begin() + (candidates - 1), proposals.end(),
+                     nearer);
+    proposals.resize(candidates);
+  }
+  // 2. Their exact distances from the forward index: the query as dense
+  //    arrays, zero off its words, so that each candidate's words are summed
+  //    in word order with zero terms elsewhere, the same doubles as the scan.
+  thread_local std::vector<double> dense_x, dense_g;
+  dense_x.assign(vocabulary_, 0.0);
+  dense_g.assign(vocabulary_, 0.0);
+  for (std::size_t i = 0; i < q.words.size(); ++i) {
+    dense_x[q.words[i]] = q.weights[i];
+    dense_g[q.words[i]] = q.g[i];
+  }
+  // Read-only from here: the re-ranking threads share them.
+  const double* x = dense_x.data();
+  const double* gx = dense_g.data();
+  std::vector<KlNeighbor> out(proposals.size());
+  constexpr std::size_t kPerTask = 256;
+  ParallelFor((proposals.size() + kPerTask - 1) / kPerTask, num_threads, [&](std::size_t task) {
+    const std::size_t end = std::min(proposals.size(), (task + 1) * kPerTask);
+    for (std::size_t c = task * kPerTask; c < end; ++c) {
+      const Proposal& p = proposals[c];
+      const Segment& seg = *segments_[p.segment];
+      double query_side = 0.0, model_side = 0.0;
+      const std::size_t first = p.slot == 0 ? 0 : seg.forward_end[p.slot - 1];
+      for (std::size_t i = first; i < seg.forward_end[p.slot]; ++i) {
+        const uint16_t word = seg.forward_words[i];
+        const Float2 value = seg.values[seg.forward_values[i]];
+        query_side += x[word] * static_cast<double>(value[0]);
+        model_side += static_cast<double>(value[1]) * gx[word];
+      }
+      const double distance = Combine(q, seg, p.slot, query_side, model_side);
+      out[c] = {seg.docs[p.slot], distance > 0.0 ? static_cast<float>(distance) : 0.0f};
+    }
+  });
+  return out;
+}
+
 absl::StatusOr<std::vector<KlNeighbor>> KlInvertedIndex::Search(const SparseHistogram& query,
                                                                 std::size_t k,
-                                                                int num_threads) const {
+                                                                int num_threads,
+                                                                std::size_t candidates) const {
   if (k == 0) return absl::InvalidArgumentError("search: k must be at least 1");
-  MESHSEEK_ASSIGN_OR_RETURN(std::vector<KlNeighbor> all, Distances(query, num_threads));
+  MESHSEEK_ASSIGN_OR_RETURN(const PreparedQuery q, Prepare(query, "query"));
+  // Candidates only when they are fewer than the models and the query can
+  // have finite distances; otherwise the exact scan is the answer.
+  std::vector<KlNeighbor> all = candidates > 0 && candidates >= k && candidates < size() &&
+                                        embedding_ && !q.empty()
+                                    ? RerankCandidates(q, candidates, num_threads)
+                                    : AllDistances(q, num_threads);
   if (all.size() > k) {
     std::nth_element(all.begin(), all.begin() + (k - 1), all.end(), Closer);
     const float kth = all[k - 1].distance;
@@ -296,40 +481,36 @@ absl::StatusOr<std::vector<float>> KlInvertedIndex::DistanceMatrix(const std::ve
     }
     column[docs[i]] = i;
   }
-  // Every row's histogram, read from the postings once per segment.
-  std::vector<std::vector<SparseHistogram>> stored(segments_.size());
-  ParallelFor(segments_.size(), num_threads, [&](std::size_t s) { stored[s] = SegmentHistograms(s); });
   std::vector<float> matrix(n * n, kInfinity);
-  std::vector<absl::Status> errors(n);
   ParallelFor(n, num_threads, [&](std::size_t i) {
     const Location at = locations_.at(docs[i]);
-    absl::StatusOr<PreparedQuery> q =
-        Prepare(stored[at.segment][at.slot], absl::StrCat("model ", docs[i]));
-    if (!q.ok()) {
-      errors[i] = q.status();
-      return;
-    }
+    const PreparedQuery q = segments_[at.segment]->Stored(at.slot);
     float* row = &matrix[i * n];
     for (std::size_t s = 0; s < segments_.size(); ++s) {
-      ScanSegment(*q, s, [&](uint32_t doc, float d) {
+      ScanSegment(q, s, [&](uint32_t doc, float d) {
         auto it = column.find(doc);
         if (it != column.end()) row[it->second] = d;
       });
     }
     row[i] = 0.0f;
   });
-  for (const absl::Status& error : errors) MESHSEEK_RETURN_IF_ERROR(error);
   return matrix;
 }
 
 std::size_t KlInvertedIndex::MemoryBytes() const {
-  std::size_t bytes = sizeof(*this) + locations_.capacity() * (sizeof(uint32_t) + sizeof(Location) + 1);
+  std::size_t bytes = sizeof(*this) +
+                      (embedding_ ? vocabulary_ * kEmbeddingDimensions * sizeof(float) : 0) +
+                      locations_.capacity() * (sizeof(uint32_t) + sizeof(Location) + 1);
   for (const auto& seg : segments_) {
     bytes += sizeof(Segment) + seg->postings.capacity() * sizeof(Segment::Postings);
     for (const Segment::Postings& p : seg->postings) {
-      bytes += p.slots.capacity() * sizeof(uint16_t) + p.weights.capacity() * sizeof(float) +
-               p.g.capacity() * sizeof(float);
+      bytes += (p.slots.capacity() + p.values.capacity()) * sizeof(uint16_t);
     }
+    bytes += (seg->forward_words.capacity() + seg->forward_values.capacity()) * sizeof(uint16_t) +
+             seg->forward_end.capacity() * sizeof(std::size_t) +
+             (seg->embeddings.capacity() + seg->embedding_norms.capacity()) * sizeof(float);
+    bytes += seg->values.capacity() * sizeof(Float2) +
+             seg->value_ids.capacity() * (sizeof(uint32_t) + sizeof(uint16_t) + 1);
     bytes += seg->docs.capacity() * sizeof(uint32_t) + seg->live.capacity() + seg->empty.capacity() +
              (seg->c.capacity() + seg->e.capacity() + seg->a.capacity() + seg->big_g.capacity()) *
                  sizeof(double);

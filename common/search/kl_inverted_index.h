@@ -39,27 +39,50 @@
 // supp x and supp y. The index stores each weight as given (so a histogram read
 // back is the one stored) and never renormalises.
 //
-// Numerics. g is stored as float beside the float weight (10 bytes a posting
-// with a 16-bit slot), and a query's g is rounded to float the same way, so
-// every product x_k g(y_k) is the same double from either side. Sums run in
-// double in increasing word order. Consequences, pinned by tests: D(x, x) = 0
-// exactly (a_xy is then a_x term for term); D(x, y) and D(y, x) are the same
-// float (the formula above only swaps the operands of commutative operations),
-// so the all-pairs matrix is exactly symmetric and equals one query at a time
-// bit for bit. Negative results of cancellation are clamped to 0. Against the
-// pairwise dense code (kl_divergence.h) the only difference is the float
-// rounding of g, about 6e-8 of a_x ~ 20: distances agree to a relative 1e-5,
-// and rankings agree except between distances that close.
+// Numerics. g is kept as float beside the float weight, and a query's g is
+// rounded to float the same way, so every product x_k g(y_k) is the same
+// double from either side. Sums run in double in increasing word order.
+// Consequences, pinned by tests: D(x, x) = 0 exactly (a_xy is then a_x term
+// for term); D(x, y) and D(y, x) are the same float (the formula above only
+// swaps the operands of commutative operations), so the all-pairs matrix is
+// exactly symmetric and equals one query at a time bit for bit. Negative
+// results of cancellation are clamped to 0. Against the pairwise dense code
+// (kl_divergence.h) the only difference is the float rounding of g, about
+// 6e-8 of a_x ~ 20: distances agree to a relative 1e-5, and rankings agree
+// except between distances that close.
 //
-// Layout. Models live in segments of up to 16,384 slots; a segment keeps, per
-// word, the postings of its models as three arrays (16-bit slot, weight, g),
-// slots increasing, plus per slot the constants and a live flag. A query runs
-// segment by segment (in parallel), accumulating the two common sums of the
-// segment's models in a 256 KB array that stays in L2. Adds go to the last
-// segment; removal clears the live flag, and a segment whose dead slots exceed
-// half is rewritten without them. Segments bound the scratch memory and make
-// 16-bit slots possible: at 100,000 models with 900 words each the postings
-// take 900 MB.
+// Layout. Models live in segments of up to 16,384 slots. A segment keeps a
+// dictionary of the distinct weights of its models (with their g), and per
+// word the postings of its models as two arrays of 16-bit numbers, slot and
+// value id, slots increasing: 4 bytes a posting. Bag-of-features weights are
+// counts over a model's feature count, so a segment sees few distinct values;
+// a model whose new values would overflow the 65,536 ids opens a new segment.
+// Per slot it keeps the constants and a live flag. A query runs segment by
+// segment (in parallel), accumulating the two common sums of the segment's
+// models in a 256 KB array that stays in L2, with the dictionary beside it.
+// It streams only the postings of the query's words: exact search is bound by
+// memory bandwidth. Adds go to the last segment; removal clears the live flag,
+// and a segment whose dead slots exceed half is rewritten without them. At
+// 100,000 models of 920 words the postings take 370 MB (and the forward
+// index of the candidate stage as much again).
+//
+// Candidates. Exact search streams 4 bytes for most of a dense collection's
+// postings per query (at V = 2,000 about half the words are used): 170 MB at
+// 100,000 models, over 12 ms at the 12 GB/s of the development machine, 35 ms
+// measured. For large collections Search can instead re-rank candidates: each
+// model also has a 128-d embedding (histogram_embedding.h), the square root of
+// its histogram projected on the principal axes of the square roots of the
+// collection, whose distances approximate the Hellinger distance, a close
+// proxy of symmetric KL's ranking. The axes are fitted once, when the index
+// first holds kEmbeddingFitModels models, on those models (an index restarted
+// from the same adds fits the same axes); models added later are embedded on
+// them. The models with the nearest embeddings are re-ranked with exact
+// distances computed from a forward index (per model its words and value ids,
+// 4 bytes each), in word order with the query held as dense arrays: the same
+// doubles as the exact scan, so a candidate's distance is bit for bit its
+// exact distance; only recall can be lost, and it is measured on real
+// histograms (bench/rank_check, bench/index_benchmark, README). Memory:
+// forward index as large as the postings, 516 bytes of embedding per model.
 //
 // Models without words (no local features) have no distance to anything: +inf
 // to every other model, and as a query every distance is +inf (0 only from a
@@ -75,12 +98,14 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "common/bof/kl_divergence.h"
+#include "common/search/histogram_embedding.h"
 #include "common/search/sparse_histogram.h"
 
 namespace meshseek {
@@ -95,6 +120,11 @@ class KlInvertedIndex {
  public:
   /// Largest number of models in one segment (16-bit slots).
   static constexpr std::size_t kSegmentSlots = 1 << 14;
+  /// Dimensions of the embedding that proposes candidates.
+  static constexpr std::size_t kEmbeddingDimensions = 128;
+  /// The embedding is fitted when the index first holds this many models, on
+  /// them; below, Search with candidates scans exactly (it is fast there).
+  static constexpr std::size_t kEmbeddingFitModels = 4096;
 
   /// An empty index for histograms over `vocabulary` words; InvalidArgument
   /// for vocabulary 0 or invalid options.
@@ -133,15 +163,27 @@ class KlInvertedIndex {
 
   /// The `k` nearest models to `query` by (distance, doc), followed by any
   /// others at the k-th distance (so a caller may break ties its own way).
+  /// `candidates` = 0: exact, every model scanned. Otherwise the k nearest
+  /// among the `candidates` (>= k) models whose embeddings are nearest the
+  /// query's, with exact distances (see "Candidates" above); the exact scan
+  /// when there are no more models than that.
   absl::StatusOr<std::vector<KlNeighbor>> Search(const SparseHistogram& query,
                                                  std::size_t k,
-                                                 int num_threads) const;
+                                                 int num_threads,
+                                                 std::size_t candidates = 0) const;
 
   /// All pairs among `docs` (each stored): docs.size()^2 row-major, entry
   /// i * n + j = D(docs[i], docs[j]); exactly symmetric, zero diagonal.
   /// NotFound for a doc that is not stored.
   absl::StatusOr<std::vector<float>> DistanceMatrix(const std::vector<uint32_t>& docs,
                                                     int num_threads) const;
+
+  /// Fits the candidate embedding on every stored model now and embeds them
+  /// all (refitting if there was one). Done automatically when the index
+  /// reaches kEmbeddingFitModels; benchmarks call it to measure the candidate
+  /// stage on smaller real collections.
+  void FitEmbedding();
+  bool has_embedding() const { return embedding_.has_value(); }
 
   /// Bytes held by postings, constants and bookkeeping (capacity, not size).
   std::size_t MemoryBytes() const;
@@ -159,10 +201,22 @@ class KlInvertedIndex {
   KlInvertedIndex(uint32_t vocabulary, const KlDivergenceOptions& options);
   absl::StatusOr<PreparedQuery> Prepare(const SparseHistogram& histogram,
                                         absl::string_view name) const;
-  // Histograms of every slot of segment `s` (dead ones too), from its postings.
-  std::vector<SparseHistogram> SegmentHistograms(std::size_t s) const;
-  // Appends a prepared histogram to the last segment (a new one when full).
+  std::vector<KlNeighbor> AllDistances(const PreparedQuery& query, int num_threads) const;
+  // Exact distances to the `candidates` models the embedding puts nearest.
+  std::vector<KlNeighbor> RerankCandidates(const PreparedQuery& query,
+                                           std::size_t candidates,
+                                           int num_threads) const;
+  // D from the common sums (the formula above).
+  static double Combine(const PreparedQuery& query,
+                        const Segment& segment,
+                        std::size_t slot,
+                        double query_side,
+                        double model_side);
+  // Appends a prepared histogram to the last segment (a new one when full),
+  // fitting the embedding when the index reaches kEmbeddingFitModels.
   void Append(uint32_t doc, const PreparedQuery& prepared);
+  // q's embedding and its squared norm (embedding_ is fitted).
+  void Embed(PreparedQuery* q) const;
   // Calls emit(doc, distance) for every live model of segment `s`.
   template <typename Emit>
   void ScanSegment(const PreparedQuery& query, std::size_t s, Emit&& emit) const;
@@ -170,7 +224,8 @@ class KlInvertedIndex {
 
   uint32_t vocabulary_ = 0;
   KlDivergenceOptions options_;
-  double scale_ = 1.0;  // c = 1 / (1 + V eps)
+  // Fitted once (see "Candidates"); then every model has its embedding.
+  std::optional<HistogramEmbedding> embedding_;
   std::vector<std::unique_ptr<Segment>> segments_;
   absl::flat_hash_map<uint32_t, Location> locations_;
 };

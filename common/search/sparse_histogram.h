@@ -16,8 +16,8 @@ namespace meshseek {
 
 /// Largest vocabulary a histogram may declare. meshseek trains up to 50,000
 /// words; the bound keeps a hostile size from costing memory (the index keeps
-/// per-word bookkeeping).
-inline constexpr uint32_t kMaxVocabulary = 1 << 17;
+/// per-word bookkeeping) and lets the index name words and weights in 16 bits.
+inline constexpr uint32_t kMaxVocabulary = 1 << 16;
 
 struct SparseHistogram {
   /// Vocabulary size V: every word is less than it.

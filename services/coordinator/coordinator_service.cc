@@ -804,6 +804,7 @@ grpc::Status CoordinatorService::Query(grpc::ServerContext*,
   search.set_collection(request->collection());
   *search.mutable_histogram() = *histogram;
   search.set_top_k(request->top_k());
+  search.set_candidates(request->candidates());
   search.set_kl_epsilon(info->options.kl.epsilon);
   absl::StatusOr<std::vector<v1::ScoredModel>> found = index_->Search(search);
   if (!found.ok()) return rpc::ToGrpcStatus(found.status());

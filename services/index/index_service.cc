@@ -236,8 +236,10 @@ grpc::Status IndexService::Search(grpc::ServerContext*,
   absl::StatusOr<const Collection*> collection =
       FindCollection(request->collection(), request->kl_epsilon());
   if (!collection.ok()) return rpc::ToGrpcStatus(collection.status());
+  const std::size_t candidates =
+      request->candidates() == 0 ? 0 : std::max(request->candidates(), request->top_k());
   absl::StatusOr<std::vector<KlNeighbor>> found =
-      (*collection)->engine->Search(*query, request->top_k(), options_.num_threads);
+      (*collection)->engine->Search(*query, request->top_k(), options_.num_threads, candidates);
   if (!found.ok()) return rpc::ToGrpcStatus(found.status());
   // The engine breaks ties by doc and returns every model tied with the k-th:
   // rank ties by ordinal (then id) as the whole collection would be.
