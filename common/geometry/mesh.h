@@ -49,8 +49,10 @@ Vec3d TriangleNormal(const TriangleMesh& mesh, std::size_t t);
 double SurfaceArea(const TriangleMesh& mesh);
 
 // Checks the invariants every algorithm relies on: at least one triangle, all
-// vertex indices in range, all coordinates finite, and positive total area.
-// The message names the first offending vertex or triangle.
+// vertex indices in range, all coordinates finite, a bounding box extent and a
+// total surface area that are finite in float (coordinates near FLT_MAX are
+// finite but make both overflow), and positive total area. The message names
+// the first offending vertex or triangle, or the overflowing quantity.
 absl::Status ValidateMesh(const TriangleMesh& mesh);
 
 // Applies p -> scale * R p + t to every vertex (R row-major 3x3). Used by tests

@@ -1,178 +1,122 @@
 #include "common/geometry/mesh_io.h"
 
-#include <OpenMesh/Core/IO/IOManager.hh>
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/IO/importer/BaseImporter.hh>
-#include <OpenMesh/Core/System/omstream.hh>
 #include <cerrno>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
-#include <mutex>
-#include <sstream>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/ascii.h"
-#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
-#include "absl/strings/str_split.h"
 #include "common/base/file_io.h"
 #include "common/base/status_macros.h"
+#include "common/geometry/mesh_readers.h"
+#include "common/geometry/text_cursor.h"
 
 namespace meshseek {
 namespace {
 
-namespace OM = OpenMesh;
+using mesh_readers::PolygonSoup;
 
-// Receives what an OpenMesh format reader parses, unfiltered: positions and
-// raw polygons (as signed indices, so that bad ones stay visible). Everything
-// else readers may hand over (normals, colours, texture coordinates) is ignored.
-class SoupImporter : public OM::IO::BaseImporter {
- public:
-  std::vector<Vec3f> positions;
-  std::vector<int64_t> corners;         // all polygon corners, concatenated
-  std::vector<std::size_t> face_start;  // polygon f: corners[face_start[f] .. face_start[f+1])
-
-  SoupImporter() { face_start.push_back(0); }
-
-  OM::VertexHandle add_vertex(const OM::Vec3f& p) override {
-    positions.emplace_back(p[0], p[1], p[2]);
-    return OM::VertexHandle(static_cast<int>(positions.size()) - 1);
-  }
-  OM::VertexHandle add_vertex(const OM::Vec3d& p) override {
-    positions.emplace_back(
-        static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]));
-    return OM::VertexHandle(static_cast<int>(positions.size()) - 1);
-  }
-  OM::VertexHandle add_vertex() override { return add_vertex(OM::Vec3f(0, 0, 0)); }
-  OM::FaceHandle add_face(const VHandles& indices) override {
-    for (const OM::VertexHandle& vh : indices) corners.push_back(vh.idx());
-    face_start.push_back(corners.size());
-    return OM::FaceHandle(static_cast<int>(face_start.size()) - 2);
-  }
-  void set_point(OM::VertexHandle vh, const OM::Vec3f& p) override {
-    if (vh.idx() >= 0 && static_cast<std::size_t>(vh.idx()) < positions.size()) {
-      positions[vh.idx()] = Vec3f(p[0], p[1], p[2]);
-    }
-  }
-  void reserve(unsigned int nv, unsigned int, unsigned int nf) override {
-    // Headers can lie; cap what we pre-allocate on their word.
-    positions.reserve(std::min(nv, 1u << 24));
-    face_start.reserve(std::min(nf, 1u << 24) + 1);
-  }
-  size_t n_vertices() const override { return positions.size(); }
-  size_t n_faces() const override { return face_start.size() - 1; }
-  size_t n_edges() const override { return 0; }
-
-  // Connectivity-level and attribute calls: only the .om format uses the
-  // former, and meshseek does not read attributes.
-  OM::HalfedgeHandle add_edge(OM::VertexHandle, OM::VertexHandle) override {
-    return OM::HalfedgeHandle();
-  }
-  OM::FaceHandle add_face(OM::HalfedgeHandle) override { return OM::FaceHandle(); }
-  void add_face_texcoords(OM::FaceHandle,
-                          OM::VertexHandle,
-                          const std::vector<OM::Vec2f>&) override {}
-  void add_face_texcoords(OM::FaceHandle,
-                          OM::VertexHandle,
-                          const std::vector<OM::Vec3f>&) override {}
-  void set_face_texindex(OM::FaceHandle, int) override {}
-  void set_halfedge(OM::VertexHandle, OM::HalfedgeHandle) override {}
-  void set_normal(OM::VertexHandle, const OM::Vec3f&) override {}
-  void set_normal(OM::VertexHandle, const OM::Vec3d&) override {}
-  void set_color(OM::VertexHandle, const OM::Vec3uc&) override {}
-  void set_color(OM::VertexHandle, const OM::Vec4uc&) override {}
-  void set_color(OM::VertexHandle, const OM::Vec3f&) override {}
-  void set_color(OM::VertexHandle, const OM::Vec4f&) override {}
-  void set_texcoord(OM::VertexHandle, const OM::Vec2f&) override {}
-  void set_status(OM::VertexHandle, const OM::Attributes::StatusInfo&) override {}
-  void set_next(OM::HalfedgeHandle, OM::HalfedgeHandle) override {}
-  void set_face(OM::HalfedgeHandle, OM::FaceHandle) override {}
-  void request_face_texcoords2D() override {}
-  void set_texcoord(OM::HalfedgeHandle, const OM::Vec2f&) override {}
-  void set_texcoord(OM::VertexHandle, const OM::Vec3f&) override {}
-  void set_texcoord(OM::HalfedgeHandle, const OM::Vec3f&) override {}
-  void set_status(OM::HalfedgeHandle, const OM::Attributes::StatusInfo&) override {}
-  void set_color(OM::EdgeHandle, const OM::Vec3uc&) override {}
-  void set_color(OM::EdgeHandle, const OM::Vec4uc&) override {}
-  void set_color(OM::EdgeHandle, const OM::Vec3f&) override {}
-  void set_color(OM::EdgeHandle, const OM::Vec4f&) override {}
-  void set_status(OM::EdgeHandle, const OM::Attributes::StatusInfo&) override {}
-  void set_normal(OM::FaceHandle, const OM::Vec3f&) override {}
-  void set_normal(OM::FaceHandle, const OM::Vec3d&) override {}
-  void set_color(OM::FaceHandle, const OM::Vec3uc&) override {}
-  void set_color(OM::FaceHandle, const OM::Vec4uc&) override {}
-  void set_color(OM::FaceHandle, const OM::Vec3f&) override {}
-  void set_color(OM::FaceHandle, const OM::Vec4f&) override {}
-  void set_status(OM::FaceHandle, const OM::Attributes::StatusInfo&) override {}
-  void add_texture_information(int, std::string) override {}
-};
-
-// OpenMesh's readers are process-wide singletons with per-read member state,
-// and they report through the global omerr() stream.
-std::mutex& OpenMeshMutex() {
-  static std::mutex mu;
-  return mu;
+absl::Status Named(absl::string_view name, const absl::Status& status) {
+  return absl::Status(status.code(), absl::StrCat(name, ": ", status.message()));
 }
 
-bool IsBinaryFile(const std::string& head, MeshFormat format) {
-  switch (format) {
-    case MeshFormat::kPly:
-      return absl::StrContains(head, "format binary");
-    case MeshFormat::kOff:
-      return absl::StartsWith(head, "OFF BINARY") || absl::StrContains(head, "OFF BINARY");
-    case MeshFormat::kStl:
-      return !absl::StartsWith(absl::StripLeadingAsciiWhitespace(head), "solid") ||
-             head.find('\0') != std::string::npos;
-    case MeshFormat::kObj:
-      return false;
+// The one conversion every reader's soup goes through (see mesh_io.h for the
+// repairs), so that MeshReadReport means the same for every format.
+absl::Status BuildTriangleMesh(PolygonSoup* soup, TriangleMesh* mesh, MeshReadReport* report) {
+  report->file_vertices = soup->positions.size();
+  report->file_faces = soup->face_ends.size();
+  for (std::size_t v = 0; v < soup->positions.size(); ++v) {
+    const Vec3f& p = soup->positions[v];
+    if (!IsFinite(p)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "vertex ", v, " has a non-finite coordinate (", p.x, ", ", p.y, ", ", p.z, ")"));
+    }
+  }
+  mesh->vertices = std::move(soup->positions);
+  const int64_t nv = static_cast<int64_t>(mesh->vertices.size());
+  mesh->triangles.reserve(soup->triangles);
+  std::vector<uint32_t> polygon;
+  uint64_t begin = 0;
+  for (std::size_t f = 0; f < soup->face_ends.size(); ++f) {
+    const uint64_t end = soup->face_ends[f];
+    for (uint64_t c = begin; c < end; ++c) {
+      const int64_t index = soup->corners[c];
+      if (index < 0 || index >= nv) {
+        return absl::InvalidArgumentError(absl::StrCat("face ",
+                                                       f,
+                                                       " (0-based) references vertex ",
+                                                       index,
+                                                       ", but the file has ",
+                                                       nv,
+                                                       " vertices"));
+      }
+    }
+    const int64_t* corners = soup->corners.data() + begin;
+    const uint64_t n = end - begin;
+    begin = end;
+    if (n == 3 && corners[0] != corners[1] && corners[1] != corners[2] &&
+        corners[2] != corners[0]) {
+      mesh->triangles.push_back({static_cast<uint32_t>(corners[0]),
+                                 static_cast<uint32_t>(corners[1]),
+                                 static_cast<uint32_t>(corners[2])});
+      continue;
+    }
+    // Remove corners equal to their predecessor (cyclically), then fan.
+    polygon.clear();
+    for (uint64_t k = 0; k < n; ++k) {
+      const uint32_t index = static_cast<uint32_t>(corners[k]);
+      if (polygon.empty() || polygon.back() != index) polygon.push_back(index);
+    }
+    while (polygon.size() > 1 && polygon.front() == polygon.back()) polygon.pop_back();
+    if (polygon.size() < 3) {
+      ++report->faces_dropped;
+      continue;
+    }
+    if (polygon.size() != n) ++report->faces_repaired;
+    if (polygon.size() > 3) ++report->polygons_triangulated;
+    for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
+      mesh->triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
+    }
+  }
+  for (std::size_t t = 0; t < mesh->triangles.size(); ++t) {
+    if (!(TriangleArea(*mesh, t) > 0)) ++report->zero_area_triangles;
+  }
+  report->topology = ComputeTopologyStats(*mesh);
+  return ValidateMesh(*mesh);
+}
+
+bool IsObjKeyword(absl::string_view token) {
+  for (const char* keyword :
+       {"v", "vn", "vt", "vp", "f", "o", "g", "s", "usemtl", "mtllib", "l", "p"}) {
+    if (token == keyword) return true;
   }
   return false;
 }
 
-// OpenMesh's ASCII readers parse numbers with iostreams, which fail on "nan"
-// and "inf" and then go on with stale values. Before handing an ASCII file to
-// them, look for a non-finite number on a coordinate line (OBJ "v", STL
-// "vertex", or a line of plain numbers as in OFF and PLY bodies) so the error
-// can name the line.
-absl::Status CheckAsciiNumbers(const std::string& path) {
-  MESHSEEK_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
-  std::size_t line_no = 0;
-  std::vector<absl::string_view> tokens;
-  for (absl::string_view line : absl::StrSplit(text, '\n')) {
-    ++line_no;
-    // Only a token with one of these letters can be non-finite ("nan",
-    // "inf", "1e999"); most lines have none and are skipped without parsing.
-    if (line.find_first_of("nNiIeE") == absl::string_view::npos) continue;
-    tokens = absl::StrSplit(line, absl::ByAnyChar(" \t\r"), absl::SkipEmpty());
-    if (tokens.empty()) continue;
-    const std::size_t first = (tokens[0] == "v" || tokens[0] == "vertex") ? 1 : 0;
-    bool all_numbers = first < tokens.size();
-    absl::string_view bad;
-    for (std::size_t k = first; k < tokens.size() && all_numbers; ++k) {
-      const std::string token(tokens[k]);
-      char* end = nullptr;
-      errno = 0;
-      const double value = std::strtod(token.c_str(), &end);
-      if (end == token.c_str() || *end != '\0') {
-        all_numbers = false;
-      } else if (bad.empty() &&
-                 (!std::isfinite(value) || (errno == ERANGE && std::abs(value) > 1))) {
-        bad = tokens[k];
-      }
-    }
-    if (all_numbers && !bad.empty()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("line ", line_no, ": non-finite coordinate '", bad, "'"));
-    }
+}  // namespace
+
+absl::Status MeshReadOptions::Validate() const {
+  constexpr uint64_t kMaxIndexable = UINT32_MAX;
+  if (max_file_bytes == 0) {
+    return absl::InvalidArgumentError("MeshReadOptions.max_file_bytes = 0: must be positive");
+  }
+  if (max_vertices == 0 || max_vertices > kMaxIndexable) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "MeshReadOptions.max_vertices = ", max_vertices, ": must be in [1, ", kMaxIndexable, "]"));
+  }
+  if (max_triangles == 0 || max_triangles > kMaxIndexable) {
+    return absl::InvalidArgumentError(absl::StrCat("MeshReadOptions.max_triangles = ",
+                                                   max_triangles,
+                                                   ": must be in [1, ",
+                                                   kMaxIndexable,
+                                                   "]"));
   }
   return absl::OkStatus();
 }
-
-}  // namespace
 
 absl::StatusOr<MeshFormat> MeshFormatFromPath(absl::string_view path) {
   const std::size_t dot = path.rfind('.');
@@ -219,119 +163,108 @@ std::string MeshReadReport::Summary() const {
     parts.push_back(absl::StrCat(topology.non_manifold_edges, " non-manifold edges"));
   if (topology.unreferenced_vertices)
     parts.push_back(absl::StrCat(topology.unreferenced_vertices, " unreferenced vertices"));
+  for (const std::string& note : notes) parts.push_back(note);
   return absl::StrJoin(parts, ", ");
 }
 
-absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path, MeshReadReport* report) {
-  auto with_path = [&path](const absl::Status& st) {
-    return absl::Status(st.code(), absl::StrCat(path, ": ", st.message()));
-  };
-  MESHSEEK_ASSIGN_OR_RETURN(const MeshFormat format, MeshFormatFromPath(path));
-  std::string head;
-  {
-    std::ifstream probe(path, std::ios::binary);
-    if (!probe) {
-      return absl::NotFoundError(
-          absl::StrCat(path, ": cannot open file (", std::strerror(errno), ")"));
-    }
-    head.resize(512);
-    probe.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(probe.gcount()));
-    if (head.empty()) return absl::InvalidArgumentError(absl::StrCat(path, ": file is empty"));
+std::optional<MeshFormat> DetectMeshFormat(absl::string_view bytes) {
+  // Text magic first: a binary OFF or PLY body could, by chance, make the file
+  // size match a binary STL's; a binary STL header that starts with "OFF" or
+  // "ply" and a newline is not a real risk.
+  mesh_readers::LineCursor lines(bytes);
+  absl::string_view line, token;
+  if (lines.Next(&line) && absl::StripAsciiWhitespace(line) == "ply") return MeshFormat::kPly;
+  lines = mesh_readers::LineCursor(bytes);
+  while (lines.Next(&line)) {
+    mesh_readers::TokenCursor tokens(mesh_readers::StripComment(line, '#'));
+    if (!tokens.Next(&token)) continue;
+    mesh_readers::OffKeyword keyword;
+    if (mesh_readers::ParseOffKeyword(token, &keyword)) return MeshFormat::kOff;
+    break;  // `token`: the first statement's keyword, for OBJ below
   }
-  if (!IsBinaryFile(head, format)) {
-    const absl::Status numbers = CheckAsciiNumbers(path);
-    if (!numbers.ok()) return with_path(numbers);
+  if (mesh_readers::HasBinaryStlSize(bytes) || mesh_readers::LooksLikeAsciiStl(bytes)) {
+    return MeshFormat::kStl;
   }
+  if (!token.empty() && IsObjKeyword(token)) return MeshFormat::kObj;
+  return std::nullopt;
+}
 
-  SoupImporter importer;
-  {
-    std::lock_guard<std::mutex> lock(OpenMeshMutex());
-    static const bool silenced = [] {
-      ::omerr().disconnect(std::cerr);
-      ::omlog().disable();
-      ::omout().disable();
-      return true;
-    }();
-    (void)silenced;
-    std::ostringstream messages;
-    ::omerr().connect(messages);
-    OM::IO::Options options;
-    const bool ok = OM::IO::IOManager().read(path, importer, options);
-    ::omerr().flush();
-    ::omerr().disconnect(messages);
-    if (!ok) {
-      std::string detail(absl::StripAsciiWhitespace(messages.str()));
-      return absl::InvalidArgumentError(absl::StrCat(path,
-                                                     ": OpenMesh could not parse the file as ",
-                                                     MeshFormatName(format),
-                                                     detail.empty() ? "" : " (",
-                                                     detail,
-                                                     detail.empty() ? "" : ")"));
-    }
+absl::StatusOr<TriangleMesh> ParseMesh(absl::string_view bytes,
+                                       absl::string_view name,
+                                       std::optional<MeshFormat> declared,
+                                       const MeshReadOptions& options,
+                                       MeshReadReport* report) {
+  if (const absl::Status valid = options.Validate(); !valid.ok()) return Named(name, valid);
+  if (bytes.size() > options.max_file_bytes) {
+    return absl::ResourceExhaustedError(absl::StrCat(name,
+                                                     ": ",
+                                                     bytes.size(),
+                                                     " bytes, more than max_file_bytes (",
+                                                     options.max_file_bytes,
+                                                     ")"));
   }
-
+  if (bytes.empty()) return absl::InvalidArgumentError(absl::StrCat(name, ": file is empty"));
   MeshReadReport local;
   MeshReadReport& rep = report ? *report : local;
   rep = MeshReadReport();
-  rep.file_vertices = importer.positions.size();
-  rep.file_faces = importer.face_start.size() - 1;
-
+  const std::optional<MeshFormat> content = DetectMeshFormat(bytes);
+  if (!content && !declared) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        name, ": unknown mesh format (the content is not recognisably OFF, OBJ, PLY or STL)"));
+  }
+  rep.format = content ? *content : *declared;
+  if (content && declared && *content != *declared) {
+    rep.notes.push_back(absl::StrCat("content is ",
+                                     MeshFormatName(*content),
+                                     " although the name says ",
+                                     MeshFormatName(*declared)));
+  } else if (content && !declared) {
+    rep.notes.push_back(absl::StrCat("content is ", MeshFormatName(*content)));
+  }
+  PolygonSoup soup;
+  absl::Status read;
+  switch (rep.format) {
+    case MeshFormat::kOff:
+      read = mesh_readers::ReadOff(bytes, options, &soup);
+      break;
+    case MeshFormat::kObj:
+      read = mesh_readers::ReadObj(bytes, options, &soup);
+      break;
+    case MeshFormat::kPly:
+      read = mesh_readers::ReadPly(bytes, options, &soup);
+      break;
+    case MeshFormat::kStl:
+      read = mesh_readers::ReadStl(bytes, options, &soup);
+      break;
+  }
+  if (!read.ok()) return Named(name, read);
+  for (std::string& note : soup.notes) rep.notes.push_back(std::move(note));
   TriangleMesh mesh;
-  mesh.vertices = std::move(importer.positions);
-  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
-    if (!IsFinite(mesh.vertices[v])) {
-      const Vec3f& p = mesh.vertices[v];
-      return absl::InvalidArgumentError(absl::StrCat(
-          path, ": vertex ", v, " has a non-finite coordinate (", p.x, ", ", p.y, ", ", p.z, ")"));
-    }
-  }
-  const int64_t nv = static_cast<int64_t>(mesh.vertices.size());
-  mesh.triangles.reserve(rep.file_faces);
-  std::vector<uint32_t> polygon;
-  for (std::size_t f = 0; f + 1 < importer.face_start.size(); ++f) {
-    polygon.clear();
-    const std::size_t begin = importer.face_start[f], end = importer.face_start[f + 1];
-    for (std::size_t c = begin; c < end; ++c) {
-      const int64_t idx = importer.corners[c];
-      if (idx < 0 || idx >= nv) {
-        return absl::InvalidArgumentError(absl::StrCat(path,
-                                                       ": face ",
-                                                       f,
-                                                       " (0-based) references vertex ",
-                                                       idx,
-                                                       ", but the file has ",
-                                                       nv,
-                                                       " vertices"));
-      }
-      polygon.push_back(static_cast<uint32_t>(idx));
-    }
-    // Remove corners equal to their predecessor (cyclically).
-    const std::size_t corners_in = polygon.size();
-    std::vector<uint32_t> cleaned;
-    cleaned.reserve(polygon.size());
-    for (std::size_t k = 0; k < polygon.size(); ++k) {
-      if (!cleaned.empty() && cleaned.back() == polygon[k]) continue;
-      cleaned.push_back(polygon[k]);
-    }
-    while (cleaned.size() > 1 && cleaned.front() == cleaned.back()) cleaned.pop_back();
-    if (cleaned.size() < 3) {
-      ++rep.faces_dropped;
-      continue;
-    }
-    if (cleaned.size() != corners_in) ++rep.faces_repaired;
-    if (cleaned.size() > 3) ++rep.polygons_triangulated;
-    for (std::size_t k = 1; k + 1 < cleaned.size(); ++k) {
-      mesh.triangles.push_back({cleaned[0], cleaned[k], cleaned[k + 1]});
-    }
-  }
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    if (!(TriangleArea(mesh, t) > 0)) ++rep.zero_area_triangles;
-  }
-  rep.topology = ComputeTopologyStats(mesh);
-  const absl::Status valid = ValidateMesh(mesh);
-  if (!valid.ok()) return with_path(valid);
+  const absl::Status built = BuildTriangleMesh(&soup, &mesh, &rep);
+  if (!built.ok()) return Named(name, built);
   return mesh;
+}
+
+absl::StatusOr<TriangleMesh> ReadMesh(const std::string& path,
+                                      MeshReadReport* report,
+                                      const MeshReadOptions& options) {
+  if (const absl::Status valid = options.Validate(); !valid.ok()) return Named(path, valid);
+  const absl::StatusOr<MeshFormat> by_name = MeshFormatFromPath(path);
+  std::error_code error;
+  const uint64_t size = std::filesystem::file_size(path, error);
+  if (!error && size > options.max_file_bytes) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        path, ": ", size, " bytes, more than max_file_bytes (", options.max_file_bytes, ")"));
+  }
+  // (file_size fails for what is not a regular file; ReadFileToString then
+  // says why: not found, or a folder.)
+  MESHSEEK_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
+  if (!by_name.ok() && !DetectMeshFormat(bytes)) return by_name.status();
+  return ParseMesh(bytes,
+                   path,
+                   by_name.ok() ? std::optional<MeshFormat>(*by_name) : std::nullopt,
+                   options,
+                   report);
 }
 
 namespace {

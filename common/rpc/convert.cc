@@ -1,55 +1,38 @@
 #include "common/rpc/convert.h"
 
-#include <unistd.h>
-
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
+#include <optional>
 
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_replace.h"
-#include "common/base/file_io.h"
 #include "common/base/status_macros.h"
 #include "common/geometry/mesh_io.h"
 
 namespace meshseek::rpc {
 namespace {
 
-const char* ExtensionOf(v1::MeshFormat format) {
+std::optional<MeshFormat> FormatOf(v1::MeshFormat format) {
   switch (format) {
-    case v1::MESH_FORMAT_OFF: return ".off";
-    case v1::MESH_FORMAT_OBJ: return ".obj";
-    case v1::MESH_FORMAT_PLY: return ".ply";
-    case v1::MESH_FORMAT_STL: return ".stl";
-    default: return nullptr;
+    case v1::MESH_FORMAT_OFF: return MeshFormat::kOff;
+    case v1::MESH_FORMAT_OBJ: return MeshFormat::kObj;
+    case v1::MESH_FORMAT_PLY: return MeshFormat::kPly;
+    case v1::MESH_FORMAT_STL: return MeshFormat::kStl;
+    default: return std::nullopt;
   }
 }
 
-// Reads a mesh file sent as bytes with the same readers as files on disk, via
-// a private temporary file (OpenMesh's readers take paths).
+// Reads a mesh file sent as bytes with the same parsers as files on disk,
+// from memory. The declared format is the format tag, else the name's
+// extension; the content decides where it is recognisable (ParseMesh). The
+// default MeshReadOptions bound what the bytes may make the server allocate
+// (the message itself is bounded by gRPC's maximum message size).
 absl::StatusOr<TriangleMesh> ReadMeshFile(const v1::MeshFile& file) {
   const std::string name = file.name().empty() ? "mesh file" : file.name();
-  std::string extension;
-  if (const char* ext = ExtensionOf(file.format())) {
-    extension = ext;
-  } else {
-    MESHSEEK_ASSIGN_OR_RETURN(const MeshFormat format, MeshFormatFromPath(name));
-    extension = absl::StrCat(".", MeshFormatName(format));
+  std::optional<MeshFormat> declared = FormatOf(file.format());
+  if (!declared) {
+    const absl::StatusOr<MeshFormat> by_name = MeshFormatFromPath(name);
+    if (!by_name.ok() && !DetectMeshFormat(file.data())) return by_name.status();
+    if (by_name.ok()) declared = *by_name;
   }
-  const char* tmp = std::getenv("TMPDIR");
-  std::string path = absl::StrCat(tmp ? tmp : "/tmp", "/meshseek-mesh-XXXXXX", extension);
-  const int fd = mkstemps(path.data(), static_cast<int>(extension.size()));
-  if (fd < 0) return absl::InternalError(absl::StrCat("cannot create a temporary file for ", name));
-  close(fd);
-  absl::Status written = WriteStringToFile(path, file.data());
-  absl::StatusOr<TriangleMesh> mesh =
-      written.ok() ? ReadMesh(path) : absl::StatusOr<TriangleMesh>(written);
-  std::remove(path.c_str());
-  if (!mesh.ok()) {
-    return absl::Status(mesh.status().code(),
-                        absl::StrReplaceAll(mesh.status().message(), {{path, name}}));
-  }
-  return mesh;
+  return ParseMesh(file.data(), name, declared);
 }
 
 }  // namespace
