@@ -65,6 +65,11 @@ ABSL_FLAG(int,
           kDefaults.kmeans.max_points_per_centroid,
           "k-means trains on at most this many sampled local features per centroid");
 ABSL_FLAG(int, kmeans_iterations, kDefaults.kmeans.max_iterations, "maximum k-means iterations");
+ABSL_FLAG(std::string,
+          kmeans_assignment,
+          meshseek::KMeansAssignmentName(kDefaults.kmeans.assignment),
+          "nearest-word search of k-means and encoding: auto (exact below V = 1,000, "
+          "approximate from there), exact or approximate");
 ABSL_FLAG(uint64_t,
           seed,
           kDefaults.kmeans.seed,
@@ -103,6 +108,7 @@ v1::PipelineParams PipelineParamsFromFlags() {
   p.set_vocabulary(absl::GetFlag(FLAGS_vocabulary));
   p.set_kmeans_points_per_centroid(absl::GetFlag(FLAGS_kmeans_points_per_centroid));
   p.set_kmeans_iterations(absl::GetFlag(FLAGS_kmeans_iterations));
+  p.set_kmeans_assignment(absl::GetFlag(FLAGS_kmeans_assignment));
   p.set_seed(absl::GetFlag(FLAGS_seed));
   p.set_kl_epsilon(absl::GetFlag(FLAGS_kl_epsilon));
   return p;

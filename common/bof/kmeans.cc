@@ -11,6 +11,7 @@
 #include <unordered_set>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 #include "common/base/logging.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
@@ -188,6 +189,7 @@ absl::StatusOr<std::vector<float>> TrainKMeansImpl(const T* points,
   rep = KMeansReport();
   rep.input_points = n;
   Rng rng(options.seed);
+  const absl::Time start = absl::Now();
 
   // 1. Sub-sample.
   const std::size_t max_train = k * static_cast<std::size_t>(options.max_points_per_centroid);
@@ -313,7 +315,8 @@ absl::StatusOr<std::vector<float>> TrainKMeansImpl(const T* points,
                                               " probes)")
                                : std::string("exact assignment"))
                        << ", mean squared distance "
-                       << (rep.objective.empty() ? 0.0 : rep.objective.back());
+                       << (rep.objective.empty() ? 0.0 : rep.objective.back()) << ", "
+                       << absl::FormatDuration(absl::Trunc(absl::Now() - start, absl::Milliseconds(1)));
   }
   return centroids;
 }
@@ -348,6 +351,9 @@ absl::Status KMeansOptions::Validate() const {
   }
   if (approximate_min_centroids < 1) {
     return bad("approximate_min_centroids", approximate_min_centroids, ">= 1");
+  }
+  if (kmeans_plus_plus_max_centroids < 0) {
+    return bad("kmeans_plus_plus_max_centroids", kmeans_plus_plus_max_centroids, ">= 0");
   }
   if (approximate_groups < 0) {
     return bad("approximate_groups", approximate_groups, ">= 0 (0: automatic)");
@@ -396,7 +402,27 @@ bool KMeansOptions::UsesKMeansPlusPlus() const {
     case Seeding::kAuto:
       break;
   }
-  return !UsesApproximateAssignment();
+  return num_centroids <= kmeans_plus_plus_max_centroids;
+}
+
+const char* KMeansAssignmentName(KMeansOptions::Assignment assignment) {
+  switch (assignment) {
+    case KMeansOptions::Assignment::kAuto:
+      return "auto";
+    case KMeansOptions::Assignment::kExact:
+      return "exact";
+    case KMeansOptions::Assignment::kApproximate:
+      return "approximate";
+  }
+  return "?";
+}
+
+absl::StatusOr<KMeansOptions::Assignment> ParseKMeansAssignment(absl::string_view name) {
+  if (name.empty() || name == "auto") return KMeansOptions::Assignment::kAuto;
+  if (name == "exact") return KMeansOptions::Assignment::kExact;
+  if (name == "approximate") return KMeansOptions::Assignment::kApproximate;
+  return absl::InvalidArgumentError(absl::StrCat(
+      "k-means assignment must be 'auto', 'exact' or 'approximate', got '", name, "'"));
 }
 
 absl::StatusOr<std::vector<float>> TrainKMeans(const float* points,

@@ -48,6 +48,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "common/bof/approximate_nearest_centroid.h"
 
 namespace meshseek {
@@ -57,16 +58,16 @@ struct KMeansOptions {
   /// a Codebook trained with these options, when encoding.
   enum class Assignment {
     /// kExact below approximate_min_centroids centroids, kApproximate from there.
-    kAuto,
+    kAuto = 0,
     /// The true nearest centroid (nearest_centroid.h).
-    kExact,
+    kExact = 1,
     /// The nearest among the centroids of the approximate_probes nearest of
     /// approximate_groups groups (approximate_nearest_centroid.h).
-    kApproximate,
+    kApproximate = 2,
   };
   /// How the initial centroids are chosen (step 2 above).
   enum class Seeding {
-    /// kKMeansPlusPlus with exact assignment, kRandomDistinct with approximate.
+    /// kKMeansPlusPlus up to kmeans_plus_plus_max_centroids, kRandomDistinct above.
     kAuto,
     /// k-means++ on init_points_per_centroid points per centroid; O(k^2).
     kKMeansPlusPlus,
@@ -97,16 +98,17 @@ struct KMeansOptions {
   /// k-means++ seeding runs on a random subset of this many points per centroid
   /// (or on the whole training set if that is smaller).
   int init_points_per_centroid = 8;
-  /// See Assignment. The default keeps today's exact search for the
-  /// vocabularies of DESIGN.md 2.7 (V <= 5,000) and switches to the
-  /// approximate one where exact training and encoding become too slow.
+  /// See Assignment.
   Assignment assignment = Assignment::kAuto;
-  /// kAuto's threshold on num_centroids. At V = 10,000 over 500,000 SIFT-like
-  /// descriptors 3 exact Lloyd iterations (with k-means++) took 134 CPU s
-  /// against 18 approximate, whose search finds the exact nearest word for
-  /// 97.8% of the points (bench/results/codebook.txt). Below it exact search
-  /// stays the default: DESIGN.md 2.7's V <= 5,000 trains as before, bit for bit.
-  int approximate_min_centroids = 10000;
+  /// kAuto's threshold on num_centroids. Measured on the development sets'
+  /// DLD-SIFT features at V = 2,000 (bench/results/codebook.txt), approximate
+  /// assignment with k-means++ seeding reached a lower k-means objective than
+  /// exact (McGill 34,331 against 34,407, PSB train 47,644 against 47,860) and
+  /// the same first tier (75.0 and 75.0, 37.6 and 37.5) in a third of the CPU
+  /// time, encoding in a third too; at V = 10,000 exact is 7 times slower.
+  /// Below the threshold (small test vocabularies) exact search is both fast
+  /// and what the approximate one would reduce to.
+  int approximate_min_centroids = 1000;
   /// Number of groups G of the approximate search; 0 picks sqrt(probes * V),
   /// which minimises the distances computed per point (G + probes * V / G).
   /// At most num_centroids.
@@ -118,6 +120,10 @@ struct KMeansOptions {
   int approximate_probes = 8;
   /// See Seeding.
   Seeding seeding = Seeding::kAuto;
+  /// kAuto's threshold for k-means++: O(V^2 init_points_per_centroid dim)
+  /// multiply-adds, 4 G at V = 2,000 but 410 G at V = 20,000, where random
+  /// distinct seeds cost nothing and Lloyd catches up (bench/results/codebook.txt).
+  int kmeans_plus_plus_max_centroids = 5000;
 
   /// InvalidArgument naming the first bad field and its value.
   absl::Status Validate() const;
@@ -130,6 +136,11 @@ struct KMeansOptions {
   /// Whether seeding (kAuto resolved) is k-means++.
   bool UsesKMeansPlusPlus() const;
 };
+
+/// "auto", "exact" or "approximate": the names flags and the wire use.
+const char* KMeansAssignmentName(KMeansOptions::Assignment assignment);
+/// The assignment named so ("" is "auto"), or InvalidArgument.
+absl::StatusOr<KMeansOptions::Assignment> ParseKMeansAssignment(absl::string_view name);
 
 /// What TrainKMeans did.
 struct KMeansReport {

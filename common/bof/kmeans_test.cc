@@ -65,21 +65,25 @@ TEST(KMeansOptionsTest, DefaultsAreValidAndPinned) {
   EXPECT_EQ(options.min_points_per_centroid, 39);
   EXPECT_EQ(options.init_points_per_centroid, 8);
   EXPECT_EQ(options.assignment, KMeansOptions::Assignment::kAuto);
-  EXPECT_EQ(options.approximate_min_centroids, 10000);
+  EXPECT_EQ(options.approximate_min_centroids, 1000);
+  EXPECT_EQ(options.kmeans_plus_plus_max_centroids, 5000);
   EXPECT_EQ(options.approximate_groups, 0);
   EXPECT_EQ(options.approximate_probes, 8);
   EXPECT_EQ(options.seeding, KMeansOptions::Seeding::kAuto);
 }
 
-// Exact search (and k-means++) at today's vocabularies, approximate search
-// (and random distinct seeding) from approximate_min_centroids on.
+// Exact search below approximate_min_centroids, approximate from there;
+// k-means++ up to kmeans_plus_plus_max_centroids, random distinct seeds above.
 TEST(KMeansOptionsTest, AutomaticChoicesFollowTheVocabularySize) {
   KMeansOptions options;
-  options.num_centroids = 2000;
+  options.num_centroids = 999;
   EXPECT_FALSE(options.UsesApproximateAssignment());
   EXPECT_TRUE(options.UsesKMeansPlusPlus());
-  options.num_centroids = 9999;
-  EXPECT_FALSE(options.UsesApproximateAssignment());
+  options.num_centroids = 2000;
+  EXPECT_TRUE(options.UsesApproximateAssignment());
+  EXPECT_TRUE(options.UsesKMeansPlusPlus());
+  options.num_centroids = 5001;
+  EXPECT_FALSE(options.UsesKMeansPlusPlus());
   options.num_centroids = 10000;
   EXPECT_TRUE(options.UsesApproximateAssignment());
   EXPECT_FALSE(options.UsesKMeansPlusPlus());
@@ -92,6 +96,16 @@ TEST(KMeansOptionsTest, AutomaticChoicesFollowTheVocabularySize) {
   options.assignment = KMeansOptions::Assignment::kApproximate;
   EXPECT_TRUE(options.UsesApproximateAssignment());
   EXPECT_EQ(options.ResolvedApproximateParams(), (ApproximateSearchParams{9, 8}));
+}
+
+TEST(KMeansOptionsTest, AssignmentNamesRoundTrip) {
+  for (const auto a : {KMeansOptions::Assignment::kAuto, KMeansOptions::Assignment::kExact,
+                       KMeansOptions::Assignment::kApproximate}) {
+    EXPECT_EQ(*ParseKMeansAssignment(KMeansAssignmentName(a)), a);
+  }
+  EXPECT_EQ(*ParseKMeansAssignment(""), KMeansOptions::Assignment::kAuto);
+  EXPECT_THAT(ParseKMeansAssignment("fast").status().message(),
+              ::testing::HasSubstr("must be 'auto', 'exact' or 'approximate', got 'fast'"));
 }
 
 TEST(KMeansOptionsTest, RejectsBadFieldsNamingThem) {
@@ -320,7 +334,7 @@ TEST(TrainKMeansTest, ApproximateAssignmentIsDeterministicAndIndependentOfThread
   EXPECT_EQ(report1.objective, report2.objective);
   EXPECT_TRUE(report1.approximate_assignment);
   EXPECT_EQ(report1.approximate, (ApproximateSearchParams{21, 3}));
-  EXPECT_FALSE(report1.kmeans_plus_plus);
+  EXPECT_TRUE(report1.kmeans_plus_plus);  // k = 150 <= kmeans_plus_plus_max_centroids
 
   options.seed = 10;
   const auto other = TrainKMeans(blobs.points.data(), n, dim, options);

@@ -49,6 +49,9 @@ Json RetrievalPipelineOptions::ToJson() const {
   codebook.Set("kmeans_seed", static_cast<int64_t>(kmeans.seed));
   codebook.Set("kmeans_max_iterations", kmeans.max_iterations);
   codebook.Set("kmeans_max_points_per_centroid", kmeans.max_points_per_centroid);
+  codebook.Set("kmeans_assignment", KMeansAssignmentName(kmeans.assignment));
+  codebook.Set("nearest_word_search",
+               kmeans.UsesApproximateAssignment() ? "approximate" : "exact");
   Json& ranking = json.Set("ranking", Json::MakeObject());
   ranking.Set("distance", "symmetric KL divergence");
   ranking.Set("epsilon", kl.epsilon);

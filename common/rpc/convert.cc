@@ -258,6 +258,8 @@ absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromParams(const v1::Pip
   set(p.kmeans_points_per_centroid(), &options.kmeans.max_points_per_centroid);
   set(p.kmeans_iterations(), &options.kmeans.max_iterations);
   set(p.seed(), &options.kmeans.seed);
+  MESHSEEK_ASSIGN_OR_RETURN(options.kmeans.assignment,
+                            ParseKMeansAssignment(p.kmeans_assignment()));
   set(p.kl_epsilon(), &options.kl.epsilon);
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   return options;

@@ -92,8 +92,15 @@ grpc::Status CodebookService::Train(grpc::ServerContext*,
                                      " descriptor bytes are not a multiple of ", dim));
   }
   // The same k-means options as the in-process pipeline's
-  // TrainCollectionCodebook: the defaults, then the four that are parameters.
+  // TrainCollectionCodebook: the defaults, then the five that are parameters.
   KMeansOptions kmeans;
+  absl::StatusOr<KMeansOptions::Assignment> assignment =
+      ParseKMeansAssignment(first.kmeans_assignment());
+  if (!assignment.ok()) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrCat("train ", id, ": ", assignment.status().message()));
+  }
+  kmeans.assignment = *assignment;
   if (first.vocabulary() > 0) kmeans.num_centroids = first.vocabulary();
   if (first.kmeans_points_per_centroid() > 0) {
     kmeans.max_points_per_centroid = first.kmeans_points_per_centroid();

@@ -676,6 +676,7 @@ void CoordinatorService::RunBuild(const std::string& job_id, const std::string& 
   };
   absl::StatusOr<CollectionInfo> info = FindCollection(collection);
   if (!info.ok()) return fail(info.status());
+  const absl::Time start = absl::Now();
   struct Member {
     std::string model_id;
     uint64_t ordinal;
@@ -727,6 +728,7 @@ void CoordinatorService::RunBuild(const std::string& job_id, const std::string& 
         chunk.set_vocabulary(info->options.kmeans.num_centroids);
         chunk.set_kmeans_points_per_centroid(info->options.kmeans.max_points_per_centroid);
         chunk.set_kmeans_iterations(info->options.kmeans.max_iterations);
+        chunk.set_kmeans_assignment(KMeansAssignmentName(info->options.kmeans.assignment));
         chunk.set_seed(info->options.kmeans.seed);
         chunk.set_dimension(kSiftDimension);
         bool open = true;
@@ -743,6 +745,7 @@ void CoordinatorService::RunBuild(const std::string& job_id, const std::string& 
       },
       retry_, &stop_);
   if (!trained.ok()) return fail(Prefixed(trained, "codebook training: "));
+  const absl::Time trained_at = absl::Now();
   // 2. Encode and index every model not yet indexed with this codebook.
   std::vector<absl::Status> errors(members.size());
   ParallelFor(members.size(), options_.max_in_flight, [&](std::size_t i) {
@@ -772,6 +775,10 @@ void CoordinatorService::RunBuild(const std::string& job_id, const std::string& 
       return;
     }
   }
+  MESHSEEK_LOG(INFO) << "coordinator: " << job_id << ": " << members.size()
+                     << " models; features loaded and codebook trained in "
+                     << absl::FormatDuration(trained_at - start) << ", encoded and indexed in "
+                     << absl::FormatDuration(absl::Now() - trained_at);
   (void)FinishJob(job_id, v1::JOB_STATE_SUCCEEDED,
                   absl::StrCat(members.size(), " models indexed with codebook ", codebook_id));
   absl::MutexLock lock(&mutex_);
