@@ -88,19 +88,64 @@ bool OrientedBox::MayOverlap(const Aabb& box) const {
   return true;
 }
 
+namespace {
+
+// OrientedBox::MayOverlap with what does not depend on the node computed
+// once per query.
+auto OrientedBoxTest(const OrientedBox& box) {
+  // MayOverlap with what does not depend on the node computed once: the same
+  // products and sums in the same order, so the same answers.
+  struct Test {
+    OrientedBox box;
+    double abs_axes[3][3];  // |axes[i][j]|
+    double spread[3][3];    // half_extents[i] |axes[i][j]|
+    bool operator()(const Aabb& b) const {
+      const Vec3d box_center = (Vec3d(b.min) + Vec3d(b.max)) * 0.5;
+      const Vec3d box_half = (Vec3d(b.max) - Vec3d(b.min)) * 0.5;
+      const Vec3d d = box.center - box_center;
+      for (int j = 0; j < 3; ++j) {
+        double reach = box_half[j];
+        for (int i = 0; i < 3; ++i) reach += spread[i][j];
+        if (std::abs(d[j]) > reach) return false;
+      }
+      for (int i = 0; i < 3; ++i) {
+        double reach = box.half_extents[i];
+        for (int j = 0; j < 3; ++j) reach += box_half[j] * abs_axes[i][j];
+        if (std::abs(Dot(d, box.axes[i])) > reach) return false;
+      }
+      return true;
+    }
+  };
+  Test test{box, {}, {}};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      test.abs_axes[i][j] = std::abs(box.axes[i][j]);
+      test.spread[i][j] = box.half_extents[i] * test.abs_axes[i][j];
+    }
+  }
+  return test;
+}
+
+}  // namespace
+
 void TriangleBvh::Query(const Aabb& box, std::vector<uint32_t>* out) const {
-  Traverse([&box](const Aabb& b) { return b.Overlaps(box); }, out);
+  Traverse([&box](const Aabb& b) { return b.Overlaps(box); },
+           [&](uint32_t first, uint32_t count) {
+             out->insert(out->end(), order_.begin() + first, order_.begin() + first + count);
+           });
 }
 
 void TriangleBvh::Query(const OrientedBox& box, std::vector<uint32_t>* out) const {
-  Traverse([&box](const Aabb& b) { return box.MayOverlap(b); }, out);
+  Traverse(OrientedBoxTest(box), [&](uint32_t first, uint32_t count) {
+    out->insert(out->end(), order_.begin() + first, order_.begin() + first + count);
+  });
 }
 
 // Leaves are tested by their node box only: a leaf's few triangles are cheaper
 // to hand to the caller, which rejects far ones in its own first step, than to
 // test box by box.
-template <typename Overlaps>
-void TriangleBvh::Traverse(const Overlaps& overlaps, std::vector<uint32_t>* out) const {
+template <typename Overlaps, typename Leaf>
+void TriangleBvh::Traverse(const Overlaps& overlaps, const Leaf& leaf) const {
   if (nodes_.empty()) return;
   uint32_t stack[64];
   int top = 0;
@@ -110,8 +155,7 @@ void TriangleBvh::Traverse(const Overlaps& overlaps, std::vector<uint32_t>* out)
     const Node& node = nodes_[index];
     if (!overlaps(node.box)) continue;
     if (node.count > 0) {
-      out->insert(
-          out->end(), order_.begin() + node.first, order_.begin() + node.first + node.count);
+      leaf(node.first, node.count);
     } else {
       stack[top++] = node.first;  // right child
       stack[top++] = index + 1;   // left child (depth-first layout)

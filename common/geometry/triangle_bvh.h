@@ -71,8 +71,10 @@ class TriangleBvh {
                  uint32_t end,
                  const std::vector<Aabb>& boxes,
                  const std::vector<Vec3f>& centroids);
-  template <typename Overlaps>
-  void Traverse(const Overlaps& overlaps, std::vector<uint32_t>* out) const;
+  // Calls leaf(first, count) for every leaf whose box passes `overlaps`
+  // (first: position in order_), depth first.
+  template <typename Overlaps, typename Leaf>
+  void Traverse(const Overlaps& overlaps, const Leaf& leaf) const;
 
   std::vector<Node> nodes_;
   std::vector<uint32_t> order_;
