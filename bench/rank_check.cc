@@ -166,7 +166,7 @@ int Run() {
                                       : SparseFromDense(histograms[i]);
     (void)index->Upsert(static_cast<uint32_t>(i), sparse[i]);
   }
-  // The embedding is fitted automatically from 4,096 models; fit it on this
+  // The embedding is fitted automatically from 2,048 models; fit it on this
   // (smaller) collection now, as the index would on a larger one.
   index->FitEmbedding();
   for (const std::size_t candidates : {n / 50, n / 20, n / 10, n / 5}) {

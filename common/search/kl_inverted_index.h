@@ -124,7 +124,7 @@ class KlInvertedIndex {
   static constexpr std::size_t kEmbeddingDimensions = 128;
   /// The embedding is fitted when the index first holds this many models, on
   /// them; below, Search with candidates scans exactly (it is fast there).
-  static constexpr std::size_t kEmbeddingFitModels = 4096;
+  static constexpr std::size_t kEmbeddingFitModels = 2048;
 
   /// An empty index for histograms over `vocabulary` words; InvalidArgument
   /// for vocabulary 0 or invalid options.
