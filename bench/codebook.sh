@@ -31,7 +31,8 @@ run() {
   echo
   echo "== V = 2,000 (today's default), 200,000 SIFT-like descriptors (100 per word, as the pipeline)"
   run "$BIN" --experiment=train --points=200000 --vocabulary=2000 --assignment=exact
-  run "$BIN" --experiment=train --points=200000 --vocabulary=2000 --assignment=approximate
+  run "$BIN" --experiment=train --points=200000 --vocabulary=2000 --assignment=approximate \
+    --seeding=random
   run "$BIN" --experiment=train --points=200000 --vocabulary=2000 --assignment=approximate \
     --seeding=kmeanspp
   echo

@@ -25,9 +25,9 @@ build/bench/extract_benchmark --models_dir="$DATA/msb_articulated/models" --max_
 "${PYTHON:-/usr/bin/python3}" - "$OUT/speed_extract.json" >> "$OUT/speed_extract.txt" <<'PY'
 import json, sys
 for b in json.load(open(sys.argv[1]))['benchmarks']:
-    print('%-28s median %6.1f ms/model  p90 %6.1f ms  %5.0f features/model  (%d models, %.0f vertices on average)'
-          % (b['name'].split('/iterations')[0], b['median_ms_per_model'], b['p90_ms_per_model'],
-             b['features_per_model'], b['models'], b['mean_vertices']))
+    print('%-28s median %6.1f ms/model (CPU %6.1f)  p90 %6.1f ms  %5.0f features/model  (%d models, %.0f vertices on average)'
+          % (b['name'].split('/iterations')[0], b['median_ms_per_model'], b['median_cpu_ms_per_model'],
+             b['p90_ms_per_model'], b['features_per_model'], b['models'], b['mean_vertices']))
 PY
 cat "$OUT/speed_extract.txt"
 {
