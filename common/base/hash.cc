@@ -2,11 +2,11 @@
 
 namespace meshseek {
 
-uint64_t Fnv1a64(absl::string_view bytes) {
-  uint64_t hash = 14695981039346656037ull;
+uint64_t Fnv1a64(absl::string_view bytes, uint64_t offset_basis) {
+  uint64_t hash = offset_basis;
   for (unsigned char b : bytes) {
     hash ^= b;
-    hash *= 1099511628211ull;
+    hash *= kFnv1a64Prime;
   }
   return hash;
 }

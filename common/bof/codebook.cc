@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/base/hash.h"
 #include "common/base/status_macros.h"
 
 namespace meshseek {
@@ -18,15 +19,6 @@ constexpr uint32_t kApproximateVersion = 2;
 constexpr std::size_t kHeaderBytes = 4 + 4 + 8 + 8;
 constexpr std::size_t kApproximateHeaderBytes = kHeaderBytes + 4 + 4;
 constexpr std::size_t kChecksumBytes = 8;
-
-uint64_t Fnv1a64(absl::string_view bytes) {
-  uint64_t hash = 14695981039346656037ull;
-  for (unsigned char b : bytes) {
-    hash ^= b;
-    hash *= 1099511628211ull;
-  }
-  return hash;
-}
 
 void PutLittleEndian(uint64_t value, int bytes, std::string* out) {
   for (int i = 0; i < bytes; ++i) out->push_back(static_cast<char>((value >> (8 * i)) & 0xff));

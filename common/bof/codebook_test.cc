@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "common/base/hash.h"
+
 namespace meshseek {
 namespace {
 
@@ -136,11 +138,7 @@ TEST(CodebookTest, SerializationRoundTripsExactly) {
 
 // FNV-1a 64, as the format specifies, to forge checksums in corrupt input.
 void Rehash(std::string* bytes) {
-  uint64_t hash = 14695981039346656037ull;
-  for (std::size_t i = 0; i < bytes->size() - 8; ++i) {
-    hash ^= static_cast<unsigned char>((*bytes)[i]);
-    hash *= 1099511628211ull;
-  }
+  const uint64_t hash = Fnv1a64(absl::string_view(*bytes).substr(0, bytes->size() - 8));
   for (int i = 0; i < 8; ++i) (*bytes)[bytes->size() - 8 + i] = static_cast<char>(hash >> (8 * i));
 }
 
