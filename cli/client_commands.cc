@@ -17,6 +17,7 @@
 #include "cli/commands.h"
 #include "cli/embedded_stack.h"
 #include "cli/pipeline_flags.h"
+#include "common/base/hash.h"
 #include "common/base/progress.h"
 #include "common/base/status_macros.h"
 #include "common/geometry/mesh_io.h"
@@ -321,11 +322,30 @@ absl::Status RunStatus() {
   get.set_name(collection);
   v1::Collection info;
   MESHSEEK_RETURN_IF_ERROR(Call(session->stub(), &v1::Coordinator::Stub::GetCollection, get, &info));
-  std::printf("collection %s: %llu models, %llu extracted, %llu indexed; codebook '%s'\nparams: %s\n",
+  std::printf("collection %s: %llu models, %llu pending, %llu extracted, %llu failed, %llu indexed; "
+              "codebook '%s'\nparams: %s\n",
               info.name().c_str(), static_cast<unsigned long long>(info.models()),
+              static_cast<unsigned long long>(info.pending()),
               static_cast<unsigned long long>(info.extracted()),
+              static_cast<unsigned long long>(info.failed()),
               static_cast<unsigned long long>(info.indexed()), info.codebook_id().c_str(),
               info.params().ShortDebugString().c_str());
+  // Every failed model and why, a page at a time.
+  v1::ListCollectionModelsRequest list;
+  list.set_collection(collection);
+  list.set_state(v1::MODEL_STATE_FAILED);
+  list.set_page_size(1000);
+  if (info.failed() > 0) std::printf("failed models:\n");
+  while (info.failed() > 0) {
+    v1::ListCollectionModelsResponse page;
+    MESHSEEK_RETURN_IF_ERROR(Call(session->stub(), &v1::Coordinator::Stub::ListModels, list, &page));
+    for (const v1::ModelInfo& m : page.models()) {
+      std::printf("  %s (%u attempt%s): %s\n", m.model_id().c_str(), m.attempts(),
+                  m.attempts() == 1 ? "" : "s", m.error().c_str());
+    }
+    if (page.next_page_token().empty()) break;
+    list.set_page_token(page.next_page_token());
+  }
   return absl::OkStatus();
 }
 
@@ -346,22 +366,35 @@ bool EvalInProcess() { return absl::GetFlag(FLAGS_server) == "in-process"; }
 absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
     const std::vector<ManifestEntry>& models, const RetrievalPipelineOptions& options,
     const std::string& manifest_path) {
+  const auto start = absl::Now();
+  MESHSEEK_ASSIGN_OR_RETURN(auto session, Session::Open());
+  v1::Coordinator::Stub* stub = session->stub();
   std::string collection = absl::GetFlag(FLAGS_collection);
   if (collection.empty()) {
+    // Named after the manifest's folder, the method and a hash of the
+    // parameters, so that evaluating again reuses the extracted models.
     const std::string params = PipelineParamsFromFlags().SerializeAsString();
-    uint64_t h = 1469598103934665603ull;
-    for (unsigned char c : params) h = (h ^ c) * 1099511628211ull;
     std::string folder = std::filesystem::absolute(manifest_path).parent_path().filename().string();
     for (char& c : folder) {
       if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
     }
-    collection = absl::StrCat(folder.empty() ? "eval" : folder, "-",
-                              FeatureMethodName(options.extractor.method), "-",
-                              absl::Hex(h & 0xffffffffu, absl::kZeroPad8));
+    auto name = [&](uint64_t offset_basis) {
+      return absl::StrCat(folder.empty() ? "eval" : folder, "-",
+                          FeatureMethodName(options.extractor.method), "-",
+                          absl::Hex(Fnv1a64(params, offset_basis) & 0xffffffffu, absl::kZeroPad8));
+    };
+    collection = name(kFnv1a64OffsetBasis);
+    // A data folder of an earlier release names it with the mistaken basis:
+    // keep using that collection rather than extracting everything again.
+    const std::string legacy = name(kLegacyFnv1a64OffsetBasis);
+    v1::GetCollectionRequest get;
+    v1::Collection found;
+    get.set_name(collection);
+    if (!Call(stub, &v1::Coordinator::Stub::GetCollection, get, &found).ok()) {
+      get.set_name(legacy);
+      if (Call(stub, &v1::Coordinator::Stub::GetCollection, get, &found).ok()) collection = legacy;
+    }
   }
-  const auto start = absl::Now();
-  MESHSEEK_ASSIGN_OR_RETURN(auto session, Session::Open());
-  v1::Coordinator::Stub* stub = session->stub();
   MESHSEEK_RETURN_IF_ERROR(EnsureCollection(stub, collection));
   std::vector<ModelToIngest> to_ingest;
   for (const ManifestEntry& e : models) {

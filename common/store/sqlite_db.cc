@@ -55,6 +55,39 @@ absl::StatusOr<Statement> Database::Prepare(absl::string_view sql) {
 
 int64_t Database::Changes() const { return sqlite3_changes(db_); }
 
+absl::StatusOr<int64_t> Database::UserVersion() {
+  absl::StatusOr<Statement> select = Prepare("PRAGMA user_version");
+  if (!select.ok()) return select.status();
+  absl::StatusOr<bool> row = select->Step();
+  if (!row.ok()) return row.status();
+  return *row ? select->ColumnInt(0) : 0;
+}
+
+absl::Status Database::SetUserVersion(int64_t version) {
+  // PRAGMA takes no bound parameters; the value is an integer we format.
+  return Execute(absl::StrCat("PRAGMA user_version = ", version));
+}
+
+absl::StatusOr<Transaction> Transaction::Begin(Database* db) {
+  // IMMEDIATE takes the write lock now, so a transaction never fails half
+  // way for want of it.
+  if (absl::Status s = db->Execute("BEGIN IMMEDIATE"); !s.ok()) return s;
+  return Transaction(db);
+}
+
+absl::Status Transaction::Commit() {
+  Database* db = db_;
+  db_ = nullptr;
+  if (db == nullptr) return absl::FailedPreconditionError("transaction already ended");
+  absl::Status s = db->Execute("COMMIT");
+  if (!s.ok()) (void)db->Execute("ROLLBACK");
+  return s;
+}
+
+Transaction::~Transaction() {
+  if (db_ != nullptr) (void)db_->Execute("ROLLBACK");
+}
+
 Statement::Statement(Statement&& other) noexcept
     : db_(other.db_), stmt_(other.stmt_), bind_error_(other.bind_error_) {
   other.stmt_ = nullptr;

@@ -27,6 +27,7 @@ struct sqlite3_stmt;
 namespace meshseek {
 
 class Statement;
+class Transaction;
 
 class Database {
  public:
@@ -43,6 +44,10 @@ class Database {
   absl::StatusOr<Statement> Prepare(absl::string_view sql);
   /// Rows changed by the last INSERT, UPDATE or DELETE.
   int64_t Changes() const;
+  /// PRAGMA user_version: the schema version a service stores (0 in a new
+  /// database).
+  absl::StatusOr<int64_t> UserVersion();
+  absl::Status SetUserVersion(int64_t version);
   const std::string& path() const { return path_; }
 
  private:
@@ -88,6 +93,24 @@ class Statement {
   Database* db_;
   sqlite3_stmt* stmt_;
   int bind_error_ = 0;
+};
+
+// Statements that belong together: BEGIN IMMEDIATE on Begin, COMMIT on
+// Commit, ROLLBACK when destroyed uncommitted (an early error return undoes
+// everything since Begin). Not nestable; the Database's guard must be held
+// for the transaction's whole life.
+class Transaction {
+ public:
+  static absl::StatusOr<Transaction> Begin(Database* db);
+  Transaction(Transaction&& other) noexcept : db_(other.db_) { other.db_ = nullptr; }
+  Transaction& operator=(Transaction&&) = delete;
+  ~Transaction();
+
+  absl::Status Commit();
+
+ private:
+  explicit Transaction(Database* db) : db_(db) {}
+  Database* db_;  // null once committed or rolled back
 };
 
 }  // namespace meshseek

@@ -63,5 +63,32 @@ TEST(DatabaseTest, OpenFailsWithThePath) {
   EXPECT_NE(db.status().message().find("/nonexistent-dir/x/y.db"), std::string::npos);
 }
 
+TEST(TransactionTest, CommitKeepsAndAnEarlyEndRollsBack) {
+  const std::string path = TempPath("sqlite_db_test_transaction.db");
+  auto db = Database::Open(path);
+  ASSERT_TRUE(db.ok());
+  ASSERT_TRUE((*db)->Execute("CREATE TABLE t (v INTEGER)").ok());
+  {
+    auto transaction = Transaction::Begin(db->get());
+    ASSERT_TRUE(transaction.ok());
+    ASSERT_TRUE((*db)->Execute("INSERT INTO t VALUES (1)").ok());
+    ASSERT_TRUE(transaction->Commit().ok());
+    EXPECT_FALSE(transaction->Commit().ok());  // once
+  }
+  {
+    auto transaction = Transaction::Begin(db->get());
+    ASSERT_TRUE(transaction.ok());
+    ASSERT_TRUE((*db)->Execute("INSERT INTO t VALUES (2)").ok());
+  }  // destroyed uncommitted: as if an error had returned early
+  auto count = (*db)->Prepare("SELECT COUNT(*), SUM(v) FROM t");
+  ASSERT_TRUE(count.ok());
+  ASSERT_TRUE(count->Run().ok());
+  EXPECT_EQ(count->ColumnInt(0), 1);
+  EXPECT_EQ(count->ColumnInt(1), 1);
+  EXPECT_EQ((*db)->UserVersion().value(), 0);
+  ASSERT_TRUE((*db)->SetUserVersion(7).ok());
+  EXPECT_EQ((*db)->UserVersion().value(), 7);
+}
+
 }  // namespace
 }  // namespace meshseek

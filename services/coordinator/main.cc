@@ -27,6 +27,12 @@ ABSL_FLAG(absl::Duration, call_deadline, kDefaults.call_deadline,
           "deadline of every other call to a service");
 ABSL_FLAG(int, call_attempts, kDefaults.call_attempts,
           "tries of a call that fails transiently (backoff 0.1 s doubling to 5 s)");
+ABSL_FLAG(int, model_attempts, kDefaults.model_attempts,
+          "extraction attempts of a model failing with a non-permanent error before it is FAILED");
+ABSL_FLAG(absl::Duration, retry_backoff, kDefaults.retry_backoff,
+          "wait before a model's next extraction attempt, doubled after each");
+ABSL_FLAG(absl::Duration, max_retry_backoff, kDefaults.max_retry_backoff,
+          "longest wait between a model's extraction attempts");
 
 int main(int argc, char** argv) {
   meshseek::rpc::BlockTerminationSignals();
@@ -43,6 +49,9 @@ int main(int argc, char** argv) {
   options.extract_deadline = absl::GetFlag(FLAGS_extract_deadline);
   options.call_deadline = absl::GetFlag(FLAGS_call_deadline);
   options.call_attempts = absl::GetFlag(FLAGS_call_attempts);
+  options.model_attempts = absl::GetFlag(FLAGS_model_attempts);
+  options.retry_backoff = absl::GetFlag(FLAGS_retry_backoff);
+  options.max_retry_backoff = absl::GetFlag(FLAGS_max_retry_backoff);
   auto service = meshseek::CoordinatorService::Create(options);
   if (!service.ok()) return meshseek::rpc::ExitWithError("coordinator", service.status());
   meshseek::CoordinatorService* coordinator = service->get();

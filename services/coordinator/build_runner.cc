@@ -1,0 +1,190 @@
+#include "services/coordinator/build_runner.h"
+
+#include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "common/base/logging.h"
+#include "common/base/parallel.h"
+#include "common/base/status_macros.h"
+#include "common/rpc/status.h"
+
+namespace meshseek {
+namespace {
+
+constexpr std::size_t kTrainChunkBytes = 4 << 20;
+
+absl::Status Prefixed(const absl::Status& status, const std::string& prefix) {
+  return absl::Status(status.code(), absl::StrCat(prefix, status.message()));
+}
+
+}  // namespace
+
+BuildRunner::BuildRunner(CoordinatorStore* store,
+                         Workers* workers,
+                         const CoordinatorOptions& options,
+                         const std::atomic<bool>* stop)
+    : store_(store), workers_(workers), options_(options), stop_(stop) {}
+
+BuildRunner::~BuildRunner() { Join(); }
+
+void BuildRunner::Join() {
+  std::vector<std::thread> threads;
+  {
+    absl::MutexLock lock(&mutex_);
+    threads.swap(threads_);
+  }
+  for (std::thread& t : threads) {
+    if (t.joinable()) t.join();
+  }
+}
+
+void BuildRunner::Done(const std::string& collection) {
+  absl::MutexLock lock(&mutex_);
+  building_.erase(collection);
+}
+
+absl::StatusOr<std::string> BuildRunner::Start(const std::string& collection) {
+  MESHSEEK_RETURN_IF_ERROR(LoadCollection(store_, collection).status());
+  {
+    absl::MutexLock lock(&mutex_);
+    if (!building_.insert(collection).second) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("collection '", collection, "' is already being built"));
+    }
+  }
+  absl::StatusOr<ModelCounts> counts = store_->CountModels(collection, "");
+  absl::Status ready = counts.status();
+  if (counts.ok() && (counts->pending > 0 || counts->extracted < 2)) {
+    ready = absl::FailedPreconditionError(absl::StrCat(
+        "collection '", collection, "' has ", counts->models, " models, ", counts->pending,
+        " waiting for extraction, ", counts->extracted, " extracted and ", counts->failed,
+        " failed; a build needs none waiting and at least 2 extracted"));
+  }
+  absl::StatusOr<std::string> job =
+      ready.ok() ? store_->NewJob("build", collection, counts->extracted) : ready;
+  if (!job.ok()) {
+    Done(collection);
+    return job.status();
+  }
+  absl::MutexLock lock(&mutex_);
+  threads_.emplace_back([this, job = *job, collection] { Run(job, collection); });
+  return *job;
+}
+
+absl::Status BuildRunner::ResumeInterrupted() {
+  MESHSEEK_ASSIGN_OR_RETURN(const auto builds, store_->RunningBuilds());
+  absl::MutexLock lock(&mutex_);
+  for (const auto& [job, collection] : builds) {
+    if (!building_.insert(collection).second) continue;
+    MESHSEEK_LOG(INFO) << "coordinator: resuming " << job << " of collection " << collection;
+    threads_.emplace_back([this, job = job, collection = collection] { Run(job, collection); });
+  }
+  return absl::OkStatus();
+}
+
+absl::Status BuildRunner::Train(const std::string& codebook_id,
+                                const CollectionInfo& info,
+                                const std::vector<ExtractedModel>& members) {
+  v1::Codebook::Stub* codebook = workers_->codebook();
+  return rpc::RetryTransient(
+      [&]() -> absl::Status {
+        {
+          // Trained already by this job before a restart?
+          grpc::ClientContext context;
+          rpc::SetDeadline(&context, options_.call_deadline);
+          v1::GetCodebookRequest get;
+          get.set_codebook_id(codebook_id);
+          v1::CodebookInfo existing;
+          const grpc::Status found = codebook->GetCodebook(&context, get, &existing);
+          if (found.ok()) return absl::OkStatus();
+          if (found.error_code() != grpc::StatusCode::NOT_FOUND) return rpc::FromGrpcStatus(found);
+        }
+        grpc::ClientContext context;
+        rpc::SetDeadline(&context, absl::Hours(2));  // k-means on a large collection
+        v1::CodebookInfo trained;
+        auto writer = codebook->Train(&context, &trained);
+        v1::TrainCodebookRequest chunk;
+        chunk.set_codebook_id(codebook_id);
+        chunk.set_vocabulary(info.options.kmeans.num_centroids);
+        chunk.set_kmeans_points_per_centroid(info.options.kmeans.max_points_per_centroid);
+        chunk.set_kmeans_iterations(info.options.kmeans.max_iterations);
+        chunk.set_kmeans_assignment(KMeansAssignmentName(info.options.kmeans.assignment));
+        chunk.set_seed(info.options.kmeans.seed);
+        chunk.set_dimension(kSiftDimension);
+        bool open = true;
+        v1::LocalFeatures features;
+        for (const ExtractedModel& m : members) {
+          if (!features.ParseFromString(m.features)) {
+            return absl::DataLossError(
+                absl::StrCat("model ", m.model_id, ": stored features do not parse"));
+          }
+          chunk.mutable_descriptors()->append(features.descriptors());
+          if (chunk.descriptors().size() >= kTrainChunkBytes) {
+            open = open && writer->Write(chunk);
+            chunk.clear_descriptors();
+          }
+        }
+        open = open && writer->Write(chunk);
+        writer->WritesDone();
+        return rpc::FromGrpcStatus(writer->Finish());
+      },
+      workers_->retry(), stop_);
+}
+
+void BuildRunner::Run(const std::string& job_id, const std::string& collection) {
+  const std::string codebook_id = absl::StrCat(collection, "@", job_id);
+  auto fail = [&](const absl::Status& status) {
+    MESHSEEK_LOG(ERROR) << "coordinator: " << job_id << " failed: " << status;
+    (void)store_->FinishJob(job_id, v1::JOB_STATE_FAILED, status.ToString());
+    Done(collection);
+  };
+  absl::StatusOr<CollectionInfo> info = LoadCollection(store_, collection);
+  if (!info.ok()) return fail(info.status());
+  const absl::Time start = absl::Now();
+  absl::StatusOr<std::vector<ExtractedModel>> members = store_->ExtractedModels(collection);
+  if (!members.ok()) return fail(members.status());
+  // 1. The codebook, unless a resumed build trained it already.
+  if (absl::Status trained = Train(codebook_id, *info, *members); !trained.ok()) {
+    if (*stop_) return Done(collection);  // resumed after the restart
+    return fail(Prefixed(trained, "codebook training: "));
+  }
+  const absl::Time trained_at = absl::Now();
+  // 2. Encode and index every model not yet indexed with this codebook.
+  std::vector<absl::Status> errors(members->size());
+  ParallelFor(members->size(), options_.max_in_flight, [&](std::size_t i) {
+    const ExtractedModel& m = (*members)[i];
+    if (m.indexed_codebook == codebook_id || *stop_) return;
+    v1::LocalFeatures features;
+    if (!features.ParseFromString(m.features)) {
+      errors[i] = absl::DataLossError("stored features do not parse");
+      return;
+    }
+    absl::StatusOr<v1::SparseHistogram> histogram = workers_->Encode(codebook_id, features);
+    errors[i] = histogram.ok()
+                    ? workers_->AddToIndex(collection, m.model_id, m.ordinal, m.label, *histogram)
+                    : histogram.status();
+    if (errors[i].ok()) errors[i] = store_->MarkIndexed({collection, m.model_id}, codebook_id);
+  });
+  if (*stop_) return Done(collection);  // resumed after the restart
+  for (std::size_t i = 0; i < members->size(); ++i) {
+    if (!errors[i].ok()) {
+      return fail(Prefixed(errors[i], absl::StrCat("model ", (*members)[i].model_id, ": ")));
+    }
+  }
+  if (absl::Status s = store_->SetCodebook(collection, codebook_id); !s.ok()) return fail(s);
+  absl::StatusOr<ModelCounts> counts = store_->CountModels(collection, codebook_id);
+  const uint64_t failed = counts.ok() ? counts->failed : 0;
+  MESHSEEK_LOG(INFO) << "coordinator: " << job_id << ": " << members->size()
+                     << " models; features loaded and codebook trained in "
+                     << absl::FormatDuration(trained_at - start) << ", encoded and indexed in "
+                     << absl::FormatDuration(absl::Now() - trained_at);
+  std::string message =
+      absl::StrCat(members->size(), " models indexed with codebook ", codebook_id);
+  if (failed > 0) {
+    absl::StrAppend(&message, "; ", failed, " failed models left out (meshseek status --collection ",
+                    collection, " lists them)");
+  }
+  (void)store_->FinishJob(job_id, v1::JOB_STATE_SUCCEEDED, message);
+  Done(collection);
+}
+
+}  // namespace meshseek

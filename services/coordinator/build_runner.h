@@ -1,0 +1,64 @@
+// Build jobs: train the codebook on every extracted model's stored
+// descriptors, in ingest order (the same input as the in-process pipeline),
+// then encode and index every model. The codebook id is derived from the job
+// ("<collection>@<job>") and each model records the codebook it was indexed
+// with, so a build interrupted by a restart resumes where it was
+// (ResumeInterrupted). Failed models are left out, and the job's message
+// says how many. One build per collection at a time.
+#ifndef MESHSEEK_SERVICES_COORDINATOR_BUILD_RUNNER_H_
+#define MESHSEEK_SERVICES_COORDINATOR_BUILD_RUNNER_H_
+
+#include <atomic>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
+#include "services/coordinator/coordinator_options.h"
+#include "services/coordinator/coordinator_store.h"
+#include "services/coordinator/workers.h"
+
+namespace meshseek {
+
+class BuildRunner {
+ public:
+  /// Not owned; all must outlive the runner. `stop` ends running builds
+  /// (they resume at the next start).
+  BuildRunner(CoordinatorStore* store,
+              Workers* workers,
+              const CoordinatorOptions& options,
+              const std::atomic<bool>* stop);
+  ~BuildRunner();
+
+  /// Starts a build job of `collection` and returns its id.
+  /// FailedPrecondition while one runs, while models are pending, or with
+  /// fewer than 2 extracted models.
+  absl::StatusOr<std::string> Start(const std::string& collection);
+  /// Restarts the builds a restart interrupted.
+  absl::Status ResumeInterrupted();
+  /// Joins the build threads (after `stop` was set).
+  void Join();
+
+ private:
+  void Run(const std::string& job_id, const std::string& collection);
+  absl::Status Train(const std::string& codebook_id,
+                     const CollectionInfo& info,
+                     const std::vector<ExtractedModel>& members);
+  // `collection` is no longer building.
+  void Done(const std::string& collection);
+
+  CoordinatorStore* const store_;
+  Workers* const workers_;
+  const CoordinatorOptions options_;
+  const std::atomic<bool>* const stop_;
+
+  absl::Mutex mutex_;
+  std::set<std::string> building_ ABSL_GUARDED_BY(mutex_);
+  std::vector<std::thread> threads_ ABSL_GUARDED_BY(mutex_);
+};
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_SERVICES_COORDINATOR_BUILD_RUNNER_H_

@@ -1,0 +1,200 @@
+// The coordinator's durable state: every SQL statement the coordinator runs
+// lives here. One SQLite file (coordinator.db) under the data folder holds
+//   collections (name, parameters, current codebook),
+//   models      (mesh, label, ingest ordinal, state, attempts, error,
+//                stored local features, the codebook it was indexed with),
+//   jobs        (ingest and build jobs and their state),
+//   settings    (facts fixed at first use: the number of index shards).
+//
+// Schema versions (PRAGMA user_version), migrated in order on Open, each in
+// one transaction:
+//   1  the first release's tables (created IF NOT EXISTS, so a database of
+//      that release, which stored no version, is taken as version 1);
+//   2  per-model attempts and retry time, indexes for what the dispatchers
+//      and job counts scan, and mesh fingerprints recomputed with the correct
+//      FNV-1a offset basis (version 1 used one a digit short).
+// A database of a newer version than this code knows is refused.
+//
+// States are typed (ModelState, v1::JobState); statements that belong
+// together (a model leaving PENDING and its ingest job finishing, a job and
+// its id) run in one transaction. An ingest job's state is written when it
+// changes: when its last pending model ends or its stream closes with none
+// pending, never when someone reads it.
+//
+// Thread-safe: one connection behind one mutex (SQLite serialises writers
+// anyway; statements here are short).
+#ifndef MESHSEEK_SERVICES_COORDINATOR_COORDINATOR_STORE_H_
+#define MESHSEEK_SERVICES_COORDINATOR_COORDINATOR_STORE_H_
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
+#include "common/store/sqlite_db.h"
+#include "meshseek/v1/coordinator.pb.h"
+#include "meshseek/v1/types.pb.h"
+
+namespace meshseek {
+
+/// Stored as these integers (the first release's values).
+enum class ModelState : int64_t { kPending = 0, kExtracted = 1, kFailed = 2 };
+
+v1::ModelState ToProto(ModelState state);
+
+/// The schema version this code writes.
+inline constexpr int64_t kCoordinatorSchemaVersion = 2;
+
+/// A model by its key.
+struct ModelKey {
+  std::string collection;
+  std::string model_id;
+  bool operator<(const ModelKey& o) const {
+    return std::tie(collection, model_id) < std::tie(o.collection, o.model_id);
+  }
+  bool operator==(const ModelKey& o) const {
+    return collection == o.collection && model_id == o.model_id;
+  }
+};
+
+struct StoredCollection {
+  v1::PipelineParams params;
+  std::string codebook_id;  // empty before the first build
+};
+
+struct ModelCounts {
+  uint64_t models = 0;
+  uint64_t pending = 0;
+  uint64_t extracted = 0;
+  uint64_t failed = 0;
+  uint64_t indexed = 0;  // extracted and indexed with the given codebook
+};
+
+/// What a dispatcher needs to extract one pending model.
+struct PendingModel {
+  std::string mesh;  // serialized v1::Mesh
+  uint64_t ordinal = 0;
+  std::string label;
+  int attempts = 0;  // made before this one
+  std::string job_id;
+};
+
+/// An extracted model, as a build reads it.
+struct ExtractedModel {
+  std::string model_id;
+  uint64_t ordinal = 0;
+  std::string label;
+  std::string features;  // serialized v1::LocalFeatures
+  std::string indexed_codebook;
+};
+
+class CoordinatorStore {
+ public:
+  /// Opens (creating and migrating) `data_dir`/coordinator.db. The number of
+  /// index shards is recorded at first use: FailedPrecondition when it
+  /// differs later, as models would be looked for on the wrong shards.
+  /// Streams do not survive a restart: every job's stream is marked closed
+  /// (and ingest jobs with nothing pending finish).
+  static absl::StatusOr<std::unique_ptr<CoordinatorStore>> Open(const std::string& data_dir,
+                                                                int index_shards);
+
+  // ------------------------------------------------------------ collections
+  /// NotFound when absent; DataLoss when its stored parameters do not parse.
+  absl::StatusOr<StoredCollection> GetCollection(const std::string& name);
+  /// Creates it, or nothing when it exists with the same parameters;
+  /// AlreadyExists when it exists with others.
+  absl::Status CreateCollection(const std::string& name, const v1::PipelineParams& params);
+  absl::Status SetCodebook(const std::string& collection, const std::string& codebook_id);
+  absl::StatusOr<ModelCounts> CountModels(const std::string& collection,
+                                          const std::string& codebook_id);
+
+  // ------------------------------------------------------------------- jobs
+  /// A RUNNING job with id "<kind>-<sequence>"; an ingest job starts with its
+  /// stream open.
+  absl::StatusOr<std::string> NewJob(const std::string& kind,
+                                     const std::string& collection,
+                                     uint64_t total);
+  absl::Status FinishJob(const std::string& job_id, v1::JobState state, const std::string& message);
+  /// The ingest stream of `job_id` ended; the job finishes if nothing of it
+  /// is pending.
+  absl::Status CloseIngestStream(const std::string& job_id);
+  /// The job with its progress (models counted for ingest jobs, models
+  /// indexed with the job's codebook for builds) and up to 20 errors.
+  absl::StatusOr<v1::JobStatus> GetJob(const std::string& job_id);
+  /// (job id, collection) of every RUNNING build, to resume after a restart.
+  absl::StatusOr<std::vector<std::pair<std::string, std::string>>> RunningBuilds();
+
+  // ----------------------------------------------------------------- models
+  struct AddedModel {
+    bool created = false;
+    std::string job_id;  // the job that first stored it
+  };
+  /// Stores a new PENDING model (ordinal: the collection's next), or
+  /// acknowledges the same mesh and label again without change;
+  /// AlreadyExists when the id holds another mesh or label.
+  absl::StatusOr<AddedModel> AddModel(const ModelKey& key,
+                                      const std::string& label,
+                                      const std::string& mesh,
+                                      const std::string& job_id);
+  /// Up to `limit` PENDING models whose retry time has come, oldest first,
+  /// skipping `busy`.
+  absl::StatusOr<std::vector<ModelKey>> ClaimablePending(absl::Time now,
+                                                         const std::vector<ModelKey>& busy,
+                                                         int limit);
+  /// The earliest retry time after `now` of a PENDING model in backoff.
+  absl::StatusOr<std::optional<absl::Time>> NextRetry(absl::Time now);
+  /// The model if it is still PENDING (not removed or finished meanwhile).
+  absl::StatusOr<std::optional<PendingModel>> LoadPending(const ModelKey& key);
+  uint64_t PendingCount();
+
+  /// A PENDING model's outcome, each in one transaction with its ingest job
+  /// finishing when this was the job's last pending model. false when the
+  /// model was no longer PENDING (removed meanwhile): nothing changed.
+  absl::StatusOr<bool> MarkExtracted(const ModelKey& key,
+                                     const std::string& features,
+                                     uint32_t feature_count);
+  absl::StatusOr<bool> MarkFailed(const ModelKey& key, int attempts, const std::string& reason);
+  /// A transient failure: stays PENDING, not claimable before `retry_at`.
+  absl::Status ScheduleRetry(const ModelKey& key,
+                             int attempts,
+                             absl::Time retry_at,
+                             const std::string& error);
+  absl::Status MarkIndexed(const ModelKey& key, const std::string& codebook_id);
+  /// Deletes the model; its state before, or nullopt when there was none.
+  absl::StatusOr<std::optional<ModelState>> RemoveModel(const ModelKey& key);
+
+  /// Every EXTRACTED model of the collection in ingest order.
+  absl::StatusOr<std::vector<ExtractedModel>> ExtractedModels(const std::string& collection);
+  /// A page of the collection's models (see ListCollectionModelsRequest).
+  absl::StatusOr<v1::ListCollectionModelsResponse> ListModels(const v1::ListCollectionModelsRequest& request);
+
+ private:
+  explicit CoordinatorStore(std::unique_ptr<Database> db) : db_(std::move(db)) {}
+  absl::Status Migrate(int index_shards) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  absl::Status FinishIngestJobIfDone(const std::string& job_id)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  absl::StatusOr<bool> EndPending(const ModelKey& key,
+                                  ModelState state,
+                                  int attempts,
+                                  const std::string& error,
+                                  const std::string& features,
+                                  uint32_t feature_count);
+
+  absl::Mutex mutex_;
+  std::unique_ptr<Database> db_ ABSL_GUARDED_BY(mutex_);
+};
+
+/// FNV-1a 64 of a stored mesh as 16 hex digits: tells a retried ingest from a
+/// different model under the same id.
+std::string MeshFingerprint(const std::string& mesh_bytes);
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_SERVICES_COORDINATOR_COORDINATOR_STORE_H_

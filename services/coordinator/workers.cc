@@ -1,0 +1,82 @@
+#include "services/coordinator/workers.h"
+
+#include "common/base/status_macros.h"
+#include "common/rpc/convert.h"
+
+namespace meshseek {
+
+absl::StatusOr<CollectionInfo> LoadCollection(CoordinatorStore* store, const std::string& name) {
+  MESHSEEK_ASSIGN_OR_RETURN(StoredCollection stored, store->GetCollection(name));
+  CollectionInfo info;
+  info.params = std::move(stored.params);
+  info.codebook_id = std::move(stored.codebook_id);
+  MESHSEEK_ASSIGN_OR_RETURN(info.options, rpc::PipelineOptionsFromParams(info.params));
+  return info;
+}
+
+Workers::Workers(const CoordinatorOptions& options, const std::atomic<bool>* stop)
+    : options_(options), stop_(stop) {
+  retry_.attempts = options.call_attempts;
+  rpc::ChannelOptions channel;
+  channel.max_message_bytes = options.max_message_bytes;
+  auto connect = [&](const std::string& target, const char* service) {
+    channel.retry_service = service;
+    return rpc::MakeChannel(target, channel);
+  };
+  resample_ = v1::Resample::NewStub(connect(options.resample_target, "meshseek.v1.Resample"));
+  extract_ = v1::Extract::NewStub(connect(options.extract_target, "meshseek.v1.Extract"));
+  codebook_ = v1::Codebook::NewStub(connect(options.codebook_target, "meshseek.v1.Codebook"));
+  index_ = std::make_unique<IndexShards>(*IndexShards::ParseTargets(options.index_target), channel,
+                                         options.call_deadline, retry_, stop);
+}
+
+absl::StatusOr<v1::LocalFeatures> Workers::Extract(const v1::Mesh& mesh,
+                                                   const CollectionInfo& collection,
+                                                   const std::string& model_id) {
+  v1::ExtractRequest request;
+  *request.mutable_mesh()->mutable_mesh() = mesh;
+  *request.mutable_params() = collection.params;
+  request.set_model_id(model_id);
+  if (collection.options.extractor.method == FeatureMethod::kRldSift) {
+    v1::ResampleRequest resample;
+    *resample.mutable_mesh()->mutable_mesh() = mesh;
+    resample.set_num_samples(collection.options.extractor.rld.num_samples);
+    resample.set_neighbors(collection.options.extractor.rld.neighbors);
+    v1::ResampleResponse resampled;
+    MESHSEEK_RETURN_IF_ERROR(rpc::CallWithRetry(resample_.get(), &v1::Resample::Stub::Resample,
+                                                resample, &resampled, options_.extract_deadline,
+                                                retry_, stop_));
+    *request.mutable_resampled() = std::move(*resampled.mutable_graph());
+  }
+  v1::ExtractResponse response;
+  MESHSEEK_RETURN_IF_ERROR(rpc::CallWithRetry(extract_.get(), &v1::Extract::Stub::Extract, request,
+                                              &response, options_.extract_deadline, retry_, stop_));
+  return std::move(*response.mutable_features());
+}
+
+absl::StatusOr<v1::SparseHistogram> Workers::Encode(const std::string& codebook_id,
+                                                    const v1::LocalFeatures& features) {
+  v1::EncodeRequest request;
+  request.set_codebook_id(codebook_id);
+  *request.mutable_features() = features;
+  v1::EncodeResponse response;
+  MESHSEEK_RETURN_IF_ERROR(rpc::CallWithRetry(codebook_.get(), &v1::Codebook::Stub::Encode, request,
+                                              &response, options_.call_deadline, retry_, stop_));
+  return std::move(*response.mutable_histogram());
+}
+
+absl::Status Workers::AddToIndex(const std::string& collection,
+                                 const std::string& model_id,
+                                 uint64_t ordinal,
+                                 const std::string& label,
+                                 const v1::SparseHistogram& histogram) {
+  v1::AddModelRequest request;
+  request.set_collection(collection);
+  request.set_model_id(model_id);
+  request.set_ordinal(ordinal);
+  request.set_label(label);
+  *request.mutable_histogram() = histogram;
+  return index_->Add(request);
+}
+
+}  // namespace meshseek
