@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <map>
 #include <set>
 #include <string>
@@ -39,6 +40,21 @@ namespace meshseek {
 namespace {
 
 using ::testing::HasSubstr;
+
+// CPU seconds (user + system) a process has used, from /proc/PID/stat.
+double CpuSeconds(pid_t pid) {
+  std::ifstream stat(absl::StrCat("/proc/", pid, "/stat"));
+  std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  // Fields after the command's closing parenthesis; utime and stime are the
+  // 12th and 13th of them.
+  std::istringstream rest(text.substr(text.rfind(')') + 2));
+  std::string field;
+  double ticks = 0;
+  for (int i = 1; i <= 13 && rest >> field; ++i) {
+    if (i >= 12) ticks += std::stod(field);
+  }
+  return ticks / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
 
 int FreePort() {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -118,6 +134,7 @@ class Server {
     return -1;
   }
   int port() const { return port_; }
+  pid_t pid() const { return pid_; }
 
  private:
   std::vector<std::string> args_;
@@ -130,7 +147,8 @@ class Server {
 // `index_shards` index servers and coordinator, state under `dir`.
 class Stack {
  public:
-  Stack(const std::string& dir, int extract_workers, int max_pending = 512, int index_shards = 1)
+  Stack(const std::string& dir, int extract_workers, int max_pending = 512, int index_shards = 1,
+        const std::vector<std::string>& coordinator_flags = {})
       : dir_(dir) {
     resample_ = std::make_unique<Server>("resample", std::vector<std::string>{}, FreePort());
     std::string targets;
@@ -155,6 +173,8 @@ class Stack {
                          "--index=" + shards,
                          absl::StrCat("--max_in_flight=", extract_workers),
                          absl::StrCat("--max_pending=", max_pending)};
+    coordinator_args_.insert(coordinator_args_.end(), coordinator_flags.begin(),
+                             coordinator_flags.end());
     coordinator_ = std::make_unique<Server>("coordinator", coordinator_args_, FreePort());
   }
   bool WaitServing() {
@@ -594,6 +614,60 @@ TEST_F(ServicesTest, TwoIndexShardsGiveTheResultsOfOneAndNeverAPartialAnswer) {
                 "--index=" + Address(stack.index(0).port())},
                FreePort());
   EXPECT_GT(other.WaitExit(absl::Seconds(20)), 0);
+}
+
+// A model whose extraction keeps failing (here: every extract worker is
+// gone) ends FAILED with its reason within seconds, `meshseek status` lists
+// it, the coordinator then idles, and a build goes on without it.
+TEST_F(ServicesTest, AModelThatCannotBeExtractedEndsFailedAndTheBuildGoesOnWithoutIt) {
+  Stack stack(*dir_ + "/failing", 1, 512, 1,
+              {"--model_attempts=2", "--call_attempts=2", "--retry_backoff=200ms"});
+  ASSERT_TRUE(stack.WaitServing());
+  auto stub = stack.Coordinator();
+  ASSERT_TRUE(CreateCollection(stub.get(), "failing").ok());
+  std::set<std::string> jobs;
+  ASSERT_EQ(Ingest(stub.get(), "failing", 0, 6, &jobs), 6u);
+  EXPECT_EQ(WaitJob(stub.get(), *jobs.begin()).state(), v1::JOB_STATE_SUCCEEDED);
+
+  stack.extract(0).Kill(SIGKILL);
+  jobs.clear();
+  const absl::Time start = absl::Now();
+  ASSERT_EQ(Ingest(stub.get(), "failing", 6, 7, &jobs), 1u);
+  const v1::JobStatus ingest = WaitJob(stub.get(), *jobs.begin());
+  const absl::Duration took = absl::Now() - start;
+  EXPECT_EQ(ingest.state(), v1::JOB_STATE_FAILED);
+  ASSERT_EQ(ingest.errors_size(), 1);
+  EXPECT_THAT(ingest.errors(0), HasSubstr("gave up after 2 attempts: UNAVAILABLE"));
+  EXPECT_LT(took, absl::Seconds(15));
+  std::printf("unextractable model FAILED %.1f s after its ingest\n", absl::ToDoubleSeconds(took));
+
+  std::string status;
+  {
+    const std::string command = absl::StrCat(MESHSEEK_CLI_PATH, " status --server ",
+                                              Address(stack.coordinator().port()),
+                                              " --collection failing");
+    FILE* pipe = popen(command.c_str(), "r");
+    char buffer[512];
+    while (fgets(buffer, sizeof buffer, pipe) != nullptr) status += buffer;
+    EXPECT_EQ(pclose(pipe), 0);
+  }
+  EXPECT_THAT(status, HasSubstr("7 models, 0 pending, 6 extracted, 1 failed"));
+  EXPECT_THAT(status, HasSubstr(absl::StrCat((*models_)[6].id,
+                                             " (2 attempts): gave up after 2 attempts")));
+
+  // Nothing left to retry: the coordinator idles.
+  const double cpu = CpuSeconds(stack.coordinator().pid());
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const double idle_cpu = CpuSeconds(stack.coordinator().pid()) - cpu;
+  EXPECT_LT(idle_cpu, 0.1) << "CPU seconds in 2 s with nothing to do";
+  std::printf("coordinator CPU while idle: %.2f s in 2 s\n", idle_cpu);
+
+  stack.extract(0).Start();
+  ASSERT_TRUE(stack.extract(0).WaitServing());
+  const v1::JobStatus build = WaitJob(stub.get(), Build(stub.get(), "failing"));
+  EXPECT_EQ(build.state(), v1::JOB_STATE_SUCCEEDED) << build.DebugString();
+  EXPECT_THAT(build.message(), HasSubstr("6 models indexed"));
+  EXPECT_THAT(build.message(), HasSubstr("1 failed models left out"));
 }
 
 }  // namespace
