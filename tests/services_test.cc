@@ -651,6 +651,7 @@ TEST_F(ServicesTest, AModelThatCannotBeExtractedEndsFailedAndTheBuildGoesOnWitho
     while (fgets(buffer, sizeof buffer, pipe) != nullptr) status += buffer;
     EXPECT_EQ(pclose(pipe), 0);
   }
+  std::printf("meshseek status:\n%s", status.c_str());
   EXPECT_THAT(status, HasSubstr("7 models, 0 pending, 6 extracted, 1 failed"));
   EXPECT_THAT(status, HasSubstr(absl::StrCat((*models_)[6].id,
                                              " (2 attempts): gave up after 2 attempts")));
