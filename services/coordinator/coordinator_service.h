@@ -6,7 +6,8 @@
 //
 // Its parts, in dependency order:
 //   coordinator_options  the options and their validation;
-//   coordinator_store    all durable state (SQLite), schema and migrations;
+//   coordinator_schema   the database schema, its versions and migrations;
+//   coordinator_store    all durable state (SQLite): every SQL statement;
 //   index_shards         the index as one or more shards;
 //   workers              clients of the other services, deadlines, retries;
 //   dispatcher           PENDING models -> extract -> store (-> index);

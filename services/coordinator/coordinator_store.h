@@ -6,14 +6,7 @@
 //   jobs        (ingest and build jobs and their state),
 //   settings    (facts fixed at first use: the number of index shards).
 //
-// Schema versions (PRAGMA user_version), migrated in order on Open, each in
-// one transaction:
-//   1  the first release's tables (created IF NOT EXISTS, so a database of
-//      that release, which stored no version, is taken as version 1);
-//   2  per-model attempts and retry time, indexes for what the dispatchers
-//      and job counts scan, and mesh fingerprints recomputed with the correct
-//      FNV-1a offset basis (version 1 used one a digit short).
-// A database of a newer version than this code knows is refused.
+// The schema and its versions: coordinator_schema.h.
 //
 // States are typed (ModelState, v1::JobState); statements that belong
 // together (a model leaving PENDING and its ingest job finishing, a job and
@@ -39,6 +32,7 @@
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "common/store/sqlite_db.h"
+#include "services/coordinator/coordinator_schema.h"
 #include "meshseek/v1/coordinator.pb.h"
 #include "meshseek/v1/types.pb.h"
 
@@ -48,9 +42,6 @@ namespace meshseek {
 enum class ModelState : int64_t { kPending = 0, kExtracted = 1, kFailed = 2 };
 
 v1::ModelState ToProto(ModelState state);
-
-/// The schema version this code writes.
-inline constexpr int64_t kCoordinatorSchemaVersion = 2;
 
 /// A model by its key.
 struct ModelKey {
@@ -190,10 +181,6 @@ class CoordinatorStore {
   absl::Mutex mutex_;
   std::unique_ptr<Database> db_ ABSL_GUARDED_BY(mutex_);
 };
-
-/// FNV-1a 64 of a stored mesh as 16 hex digits: tells a retried ingest from a
-/// different model under the same id.
-std::string MeshFingerprint(const std::string& mesh_bytes);
 
 }  // namespace meshseek
 
