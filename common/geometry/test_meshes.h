@@ -7,6 +7,7 @@
 #include <map>
 #include <utility>
 
+#include "common/geometry/icosphere.h"
 #include "common/geometry/mesh.h"
 
 namespace meshseek {
@@ -54,52 +55,7 @@ inline TriangleMesh Plane(int n, float h = 1.0f, float z0 = 0.0f) {
 
 // Icosphere of radius r: an icosahedron subdivided `levels` times, vertices
 // projected to the sphere. 20 * 4^levels triangles.
-inline TriangleMesh Icosphere(int levels, float r = 1.0f) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vec3d> v = {{-1, t, 0},
-                          {1, t, 0},
-                          {-1, -t, 0},
-                          {1, -t, 0},
-                          {0, -1, t},
-                          {0, 1, t},
-                          {0, -1, -t},
-                          {0, 1, -t},
-                          {t, 0, -1},
-                          {t, 0, 1},
-                          {-t, 0, -1},
-                          {-t, 0, 1}};
-  for (auto& p : v) p = Normalized(p);
-  std::vector<Triangle> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                             {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                             {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                             {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
-    auto midpoint = [&](uint32_t a, uint32_t b) {
-      const auto key = std::make_pair(std::min(a, b), std::max(a, b));
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      v.push_back(Normalized((v[a] + v[b]) * 0.5));
-      const uint32_t idx = static_cast<uint32_t>(v.size() - 1);
-      mid[key] = idx;
-      return idx;
-    };
-    std::vector<Triangle> next;
-    for (const Triangle& tri : f) {
-      const uint32_t a = midpoint(tri[0], tri[1]), b = midpoint(tri[1], tri[2]),
-                     c = midpoint(tri[2], tri[0]);
-      next.push_back({tri[0], a, c});
-      next.push_back({tri[1], b, a});
-      next.push_back({tri[2], c, b});
-      next.push_back({a, b, c});
-    }
-    f = std::move(next);
-  }
-  TriangleMesh m;
-  for (const auto& p : v) m.vertices.emplace_back(p * static_cast<double>(r));
-  m.triangles = std::move(f);
-  return m;
-}
+inline TriangleMesh Icosphere(int levels, float r = 1.0f) { return meshseek::Icosphere(levels, r); }
 
 // Copy of `mesh` in which every triangle has its own three vertices.
 inline TriangleMesh ToSoup(const TriangleMesh& mesh) {
