@@ -179,8 +179,10 @@ absl::StatusOr<std::unique_ptr<RpcServer>> RpcServer::Start(
   builder.experimental().SetInterceptorCreators(std::move(interceptors));
   builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_MS,
                              static_cast<int>(absl::ToInt64Milliseconds(options.max_connection_age)));
-  builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_GRACE_MS,
-                             static_cast<int>(absl::ToInt64Milliseconds(options.grace_period)));
+  // No GRPC_ARG_MAX_CONNECTION_AGE_GRACE_MS: an aged connection takes no new
+  // calls, and the calls on it run to their end however long they queue (a
+  // grace of a few seconds killed queued and long calls with UNAVAILABLE
+  // "enter idle" under load). Shutdown has its own grace period.
   for (grpc::Service* service : services) builder.RegisterService(service);
   server->server_ = builder.BuildAndStart();
   if (server->server_ == nullptr || server->port_ == 0) {

@@ -52,8 +52,9 @@ struct ServerOptions {
   int max_queued_calls = 256;
   /// How long in-flight calls may run on after shutdown begins.
   absl::Duration grace_period = absl::Seconds(10);
-  /// Connections are closed (gracefully) after this age so that clients
-  /// re-resolve their targets and spread over new replicas.
+  /// Connections take no new calls after this age (GOAWAY), so that clients
+  /// re-resolve their targets and spread over new replicas; the calls in
+  /// flight on them finish, however long they take.
   absl::Duration max_connection_age = absl::Seconds(30);
   /// TLS files and bearer token (credentials.h); default: plaintext, no token.
   ServerSecurityOptions security;
