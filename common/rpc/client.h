@@ -39,6 +39,9 @@ struct ChannelOptions {
   /// Name the server's certificate must carry when it is not the target's
   /// host (ClientSecurityOptions::server_name); empty: the target's host.
   std::string tls_server_name;
+  /// A connection of this channel's own instead of one shared with every
+  /// channel to the same target (load generators acting as many clients).
+  bool own_connection = false;
 };
 
 // `base` with the credentials and server name of `security` (files read now;
