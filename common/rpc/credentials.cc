@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -97,11 +98,16 @@ bool ConstantTimeEquals(const std::string& a, const std::string& b) {
 }
 
 absl::StatusOr<std::string> ReadSecretFile(const std::string& path, const std::string& what) {
+  std::error_code ignored;
+  if (std::filesystem::is_directory(path, ignored)) {
+    return absl::InvalidArgumentError(absl::StrCat(what, " '", path, "' is a folder, not a file"));
+  }
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     const int error = errno;
-    const std::string message =
-        absl::StrCat(what, " '", path, "': cannot read (", std::strerror(error), ")");
+    const std::string message = absl::StrCat(what, " '", path, "': cannot read (",
+                                             error != 0 ? std::strerror(error) : "cannot open", ")");
     if (error == EACCES) return absl::PermissionDeniedError(message);
     return absl::NotFoundError(message);
   }

@@ -69,6 +69,10 @@ TEST(CredentialsTest, MissingFileIsNamed) {
 TEST(CredentialsTest, EmptyOrBlankFilesAreRefused) {
   EXPECT_EQ(ReadSecretFile(WriteFile("meshseek_empty", ""), "--tls_ca").status().code(),
             absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(ReadSecretFile(std::filesystem::temp_directory_path().string(), "--tls_ca")
+                              .status()
+                              .message()),
+              HasSubstr("is a folder"));
   ClientSecurityOptions client;
   client.tls.ca_file = WriteFile("meshseek_ca_placeholder.pem", "not checked here");
   client.token_file = WriteFile("meshseek_blank_token", " \n\t\n");
