@@ -41,6 +41,17 @@ ABSL_FLAG(int, candidates, 0,
           "(faster on large collections, may miss a neighbour)");
 ABSL_FLAG(std::string, job, "", "status: a job id to follow until it ends");
 ABSL_FLAG(int, port, 50051, "serve: coordinator port of the embedded stack");
+ABSL_FLAG(std::string, tls_ca, "",
+          "PEM CA bundle the coordinator (--server) is verified against: turns TLS on; "
+          "serve: require client certificates signed by it");
+ABSL_FLAG(std::string, tls_cert, "",
+          "PEM certificate this process presents: the client's for mutual TLS, or serve's");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
+ABSL_FLAG(std::string, tls_server_name, "",
+          "name the coordinator's certificate carries, when not the host of --server");
+ABSL_FLAG(std::string, token_file, "",
+          "file holding the coordinator's bearer token: sent with every call to --server; "
+          "serve: required of every caller");
 ABSL_FLAG(absl::Duration, reconnect_for, absl::Minutes(2),
           "how long the client keeps reconnecting to a coordinator that went away");
 
@@ -71,6 +82,17 @@ class Session {
     }
     rpc::ChannelOptions channel;
     channel.retry_service = "";  // the client retries itself, knowing what is idempotent
+    if (session->stack_ == nullptr) {
+      // TLS and token only towards a --server: the command's own stack
+      // listens on loopback in plaintext.
+      rpc::ClientSecurityOptions security;
+      security.tls.ca_file = absl::GetFlag(FLAGS_tls_ca);
+      security.tls.cert_file = absl::GetFlag(FLAGS_tls_cert);
+      security.tls.key_file = absl::GetFlag(FLAGS_tls_key);
+      security.server_name = absl::GetFlag(FLAGS_tls_server_name);
+      security.token_file = absl::GetFlag(FLAGS_token_file);
+      MESHSEEK_ASSIGN_OR_RETURN(channel, rpc::WithClientSecurity(security, channel));
+    }
     session->stub_ = v1::Coordinator::NewStub(rpc::MakeChannel(address, channel));
     return session;
   }
@@ -351,9 +373,15 @@ absl::Status RunStatus() {
 
 absl::Status RunServe() {
   rpc::BlockTerminationSignals();
+  EmbeddedSecurity security;
+  security.coordinator.tls.cert_file = absl::GetFlag(FLAGS_tls_cert);
+  security.coordinator.tls.key_file = absl::GetFlag(FLAGS_tls_key);
+  security.coordinator.tls.ca_file = absl::GetFlag(FLAGS_tls_ca);
+  security.coordinator.token_file = absl::GetFlag(FLAGS_token_file);
+  MESHSEEK_RETURN_IF_ERROR(security.coordinator.Validate());
   MESHSEEK_ASSIGN_OR_RETURN(auto stack, EmbeddedStack::Start(absl::GetFlag(FLAGS_data_dir),
                                                              absl::GetFlag(FLAGS_threads),
-                                                             absl::GetFlag(FLAGS_port)));
+                                                             absl::GetFlag(FLAGS_port), security));
   std::printf("meshseek serving on %s (data in %s); Ctrl-C stops\n",
               stack->coordinator_address().c_str(), absl::GetFlag(FLAGS_data_dir).c_str());
   std::fflush(stdout);

@@ -6,14 +6,17 @@
 
 namespace meshseek::cli {
 
-absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(const std::string& data_dir,
-                                                                     int threads,
-                                                                     int coordinator_port) {
+absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(
+    const std::string& data_dir,
+    int threads,
+    int coordinator_port,
+    const EmbeddedSecurity& security) {
   std::unique_ptr<EmbeddedStack> stack(new EmbeddedStack());
   const int cores = ResolveThreadCount(threads);
   rpc::ServerOptions server;
   server.address = "127.0.0.1:0";
   server.grace_period = absl::Seconds(2);
+  server.security.tls = security.internal;
   auto serve = [&](const char* name, grpc::Service* service) -> absl::StatusOr<std::string> {
     MESHSEEK_ASSIGN_OR_RETURN(auto started, rpc::RpcServer::Start(name, {service}, server));
     const std::string address = absl::StrCat("127.0.0.1:", started->port());
@@ -35,8 +38,12 @@ absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(const std::s
   MESHSEEK_ASSIGN_OR_RETURN(coordinator.codebook_target, serve("codebook", stack->codebook_.get()));
   MESHSEEK_ASSIGN_OR_RETURN(coordinator.index_target, serve("index", stack->index_.get()));
   coordinator.max_in_flight = cores;
+  rpc::ClientSecurityOptions outbound;
+  outbound.tls = security.internal;
+  MESHSEEK_ASSIGN_OR_RETURN(coordinator.service_credentials, rpc::MakeChannelCredentials(outbound));
   MESHSEEK_ASSIGN_OR_RETURN(stack->coordinator_, CoordinatorService::Create(coordinator));
   server.address = absl::StrCat("127.0.0.1:", coordinator_port);
+  server.security = security.coordinator;
   MESHSEEK_ASSIGN_OR_RETURN(stack->coordinator_address_,
                             serve("coordinator", stack->coordinator_.get()));
   return stack;

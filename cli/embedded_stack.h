@@ -20,14 +20,27 @@
 
 namespace meshseek::cli {
 
+struct EmbeddedSecurity {
+  /// TLS, client certificates and bearer token of the coordinator's port
+  /// (`meshseek serve --tls_cert ... --token_file ...`). Default: plaintext.
+  rpc::ServerSecurityOptions coordinator;
+  /// Mutual TLS among the services: each serves with cert_file/key_file and
+  /// requires client certificates signed by ca_file, and the coordinator
+  /// presents the same certificate to them (it must name 127.0.0.1). Off
+  /// when empty: the inner services listen on loopback only.
+  rpc::TlsOptions internal;
+};
+
 class EmbeddedStack {
  public:
   /// Starts the five services; the coordinator listens on `coordinator_port`
   /// (0: any free port) on 127.0.0.1, the others on free loopback ports.
   /// `threads`: extraction slots and coordinator in-flight models (<= 0: cores).
-  static absl::StatusOr<std::unique_ptr<EmbeddedStack>> Start(const std::string& data_dir,
-                                                               int threads,
-                                                               int coordinator_port = 0);
+  static absl::StatusOr<std::unique_ptr<EmbeddedStack>> Start(
+      const std::string& data_dir,
+      int threads,
+      int coordinator_port = 0,
+      const EmbeddedSecurity& security = {});
   ~EmbeddedStack();
 
   /// "127.0.0.1:PORT" of the coordinator.

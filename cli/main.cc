@@ -25,7 +25,8 @@ namespace {
 
 constexpr char kUsage[] = R"(meshseek: 3-D shape retrieval with local depth-image SIFT features.
 
-Every command below talks gRPC to a coordinator: --server HOST:PORT, or, by
+Every command below talks gRPC to a coordinator: --server HOST:PORT (with
+--tls_ca CA.pem and --token_file FILE when it wants TLS and a token), or, by
 default, an embedded stack of all services started for the command with its
 state in --data_dir (default ./meshseek-data).
 
@@ -45,6 +46,7 @@ Commands:
            meshseek query MODEL --collection C --top_k 10
   status Show a collection, or follow a job: meshseek status --collection C | --job ID
   serve  Run the embedded stack until Ctrl-C: meshseek serve --port 50051
+         [--tls_cert C --tls_key K [--tls_ca CA] [--token_file T]]
   synth  Write the built-in labelled synthetic benchmark (procedural shapes):
            meshseek synth --out DIR
          writes DIR/manifest.csv, DIR/synthetic.cla and DIR/models/.

@@ -18,6 +18,7 @@ PACKAGES=(
 if [ "${1:-}" != "--build-only" ]; then
   PACKAGES+=(
     ccache python3                                   # faster rebuilds; python3 runs the reference evaluator
+    openssl                                          # tests/security_test makes a throwaway CA (deploy/make-certs.sh)
     libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
     libfaiss-dev libopenblas-dev                     # yardsticks of bench/codebook_benchmark (Faiss on OpenBLAS)
   )

@@ -544,6 +544,40 @@ TEST_F(ServicesTest, BadInputGetsTheRightCodeANamedProblemAndServersKeepServing)
   }
 }
 
+// The burst of the hardening issue: 64 concurrent AddModel calls to an index
+// with its default 16 server threads were refused ("Server Threadpool
+// Exhausted"); now they wait in the server's queue and all succeed.
+TEST(ServicesLoadTest, SixtyFourConcurrentAddModelCallsToTheIndexAllSucceed) {
+  const std::string dir = ::testing::TempDir() + "/meshseek_index_burst";
+  std::filesystem::remove_all(dir);
+  Server index("index", {"--data_dir=" + dir}, FreePort());
+  ASSERT_TRUE(index.WaitServing());
+  auto stub = v1::Index::NewStub(rpc::MakeChannel(Address(index.port())));
+  constexpr int kCalls = 64;
+  std::vector<grpc::Status> statuses(kCalls);
+  std::vector<std::thread> clients;
+  for (int i = 0; i < kCalls; ++i) {
+    clients.emplace_back([&, i] {
+      grpc::ClientContext context;
+      rpc::SetDeadline(&context, absl::Seconds(60));
+      v1::AddModelRequest request;
+      request.set_collection("burst");
+      request.set_model_id(absl::StrCat("m", i));
+      request.set_ordinal(i);
+      request.mutable_histogram()->set_size(16);
+      request.mutable_histogram()->add_bins(i % 16);
+      request.mutable_histogram()->add_weights(1.0f);
+      v1::AddModelResponse response;
+      statuses[i] = stub->AddModel(&context, request, &response);
+    });
+  }
+  for (auto& c : clients) c.join();
+  for (int i = 0; i < kCalls; ++i) {
+    EXPECT_TRUE(statuses[i].ok()) << "call " << i << ": " << statuses[i].error_code() << " "
+                                  << statuses[i].error_message();
+  }
+}
+
 TEST_F(ServicesTest, TwoIndexShardsGiveTheResultsOfOneAndNeverAPartialAnswer) {
   Stack stack(*dir_ + "/shards", 1, 512, /*index_shards=*/2);
   ASSERT_TRUE(stack.WaitServing());

@@ -6,6 +6,8 @@
 // "ipv4:127.0.0.1:7001,127.0.0.1:7002" (a fixed list, as the tests use).
 // Calls are spread over all addresses by round_robin, and the client's
 // health checking (grpc.health.v1) skips replicas that say NOT_SERVING.
+// TLS, client certificates and bearer tokens come from credentials.h
+// (WithClientSecurity below).
 #ifndef MESHSEEK_COMMON_RPC_CLIENT_H_
 #define MESHSEEK_COMMON_RPC_CLIENT_H_
 
@@ -17,7 +19,9 @@
 #include <string>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "common/rpc/credentials.h"
 
 namespace meshseek::rpc {
 
@@ -30,7 +34,20 @@ struct ChannelOptions {
   std::string retry_service;
   /// Attempts of such a retry, 2-5.
   int max_attempts = 4;
+  /// Channel credentials (MakeChannelCredentials); null: plaintext.
+  std::shared_ptr<grpc::ChannelCredentials> credentials;
+  /// Name the server's certificate must carry when it is not the target's
+  /// host (ClientSecurityOptions::server_name); empty: the target's host.
+  std::string tls_server_name;
+  /// A connection of this channel's own instead of one shared with every
+  /// channel to the same target (load generators acting as many clients).
+  bool own_connection = false;
 };
+
+// `base` with the credentials and server name of `security` (files read now;
+// errors name the file and its flag).
+absl::StatusOr<ChannelOptions> WithClientSecurity(const ClientSecurityOptions& security,
+                                                  ChannelOptions base = {});
 
 std::shared_ptr<grpc::Channel> MakeChannel(const std::string& target,
                                            const ChannelOptions& options = {});

@@ -6,9 +6,15 @@
 //   - reflection, so grpcurl can list and call the services;
 //   - explicit message-size limits (over-limit messages fail with
 //     RESOURCE_EXHAUSTED naming the limit; the server keeps serving);
-//   - a bounded worker pool (the synchronous server's thread cap): excess
-//     calls wait in gRPC's flow control or get RESOURCE_EXHAUSTED, nothing
-//     queues without bound;
+//   - bounded concurrency with a bounded queue (admission): at most
+//     `max_threads` unary calls run at once; up to `max_queued_calls` more
+//     wait, first come first served, on a thread of their own; a call beyond
+//     both gets RESOURCE_EXHAUSTED at once (gRPC's "Server Threadpool
+//     Exhausted": the thread cap below is what makes it). A burst of 64 calls
+//     to a 16-thread server is therefore served, not refused;
+//   - TLS, mutual TLS and a bearer token (credentials.h, `security`), and an
+//     optional plaintext port that serves only grpc.health.v1, for probes
+//     that cannot speak TLS (kubelet's gRPC probes);
 //   - a maximum connection age, so clients re-resolve DNS and find new
 //     replicas;
 //   - graceful shutdown: NOT_SERVING, stop taking calls, let in-flight calls
@@ -25,6 +31,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "common/rpc/credentials.h"
 
 namespace meshseek::rpc {
 
@@ -34,13 +41,26 @@ struct ServerOptions {
   /// Largest message received or sent. Meshes of a million triangles and a
   /// collection's worth of descriptor chunks fit in the default.
   int max_message_bytes = 64 << 20;
-  /// Threads serving calls (the worker pool bound).
+  /// Unary calls running at once (the worker pool bound). Streaming calls
+  /// and health checks do not wait for a slot (a stream may stay open for
+  /// minutes), but do take a thread of the cap below while open.
   int max_threads = 16;
+  /// Unary calls that wait for a running slot when all are taken. Each holds
+  /// a sleeping thread and its received request. gRPC's thread cap is set to
+  /// max_threads + max_queued_calls + 2 (its pollers), so the queue is the
+  /// bound: beyond it a call gets RESOURCE_EXHAUSTED immediately.
+  int max_queued_calls = 256;
   /// How long in-flight calls may run on after shutdown begins.
   absl::Duration grace_period = absl::Seconds(10);
-  /// Connections are closed (gracefully) after this age so that clients
-  /// re-resolve their targets and spread over new replicas.
+  /// Connections take no new calls after this age (GOAWAY), so that clients
+  /// re-resolve their targets and spread over new replicas; the calls in
+  /// flight on them finish, however long they take.
   absl::Duration max_connection_age = absl::Seconds(30);
+  /// TLS files and bearer token (credentials.h); default: plaintext, no token.
+  ServerSecurityOptions security;
+  /// host:port of a plaintext port that serves grpc.health.v1 only (and
+  /// mirrors the main port's serving status); empty: none. Port 0 picks one.
+  std::string health_address;
 
   absl::Status Validate() const;
 };
@@ -56,6 +76,8 @@ class RpcServer {
 
   /// The bound port.
   int port() const { return port_; }
+  /// The bound health-only port; 0 when there is none.
+  int health_port() const { return health_port_; }
   /// Graceful shutdown as described above; idempotent.
   void Shutdown();
 
@@ -64,7 +86,9 @@ class RpcServer {
   std::string name_;
   ServerOptions options_;
   std::unique_ptr<grpc::Server> server_;
+  std::unique_ptr<grpc::Server> health_server_;
   int port_ = 0;
+  int health_port_ = 0;
   bool shut_down_ = false;
 };
 

@@ -9,7 +9,18 @@
 ABSL_FLAG(std::string, host, "0.0.0.0", "address to listen on");
 ABSL_FLAG(int, port, 0, "port to listen on (0: any free port, printed at start)");
 ABSL_FLAG(int, max_message_mb, 64, "largest gRPC message received or sent, MiB");
-ABSL_FLAG(int, server_threads, 16, "threads serving calls (bounded worker pool)");
+ABSL_FLAG(int, server_threads, 16, "unary calls served at once (bounded worker pool)");
+ABSL_FLAG(int, max_queued_calls, 256,
+          "unary calls that wait for a server thread beyond --server_threads; "
+          "beyond both a call gets RESOURCE_EXHAUSTED");
+ABSL_FLAG(std::string, tls_cert, "",
+          "PEM certificate chain this server presents; with --tls_key turns TLS on (plaintext refused)");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
+ABSL_FLAG(std::string, tls_ca, "",
+          "PEM CA bundle: require client certificates signed by it (mutual TLS; needs --tls_cert)");
+ABSL_FLAG(int, health_port, 0,
+          "also serve grpc.health.v1 alone in plaintext on this port, for probes that cannot "
+          "speak TLS (kubelet gRPC probes); 0: none");
 ABSL_FLAG(absl::Duration,
           grace_period,
           absl::Seconds(10),
@@ -37,6 +48,20 @@ absl::StatusOr<ServerOptions> ServerOptionsFromFlags() {
   }
   options.max_message_bytes = mb << 20;
   options.max_threads = absl::GetFlag(FLAGS_server_threads);
+  options.max_queued_calls = absl::GetFlag(FLAGS_max_queued_calls);
+  options.security.tls.cert_file = absl::GetFlag(FLAGS_tls_cert);
+  options.security.tls.key_file = absl::GetFlag(FLAGS_tls_key);
+  options.security.tls.ca_file = absl::GetFlag(FLAGS_tls_ca);
+  const int health_port = absl::GetFlag(FLAGS_health_port);
+  if (health_port < 0 || health_port > 65535 || (health_port != 0 && health_port == port)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--health_port must be in [1, 65535] and differ from --port (0: none), got ", health_port));
+  }
+  if (health_port != 0) {
+    options.health_address = host.find(':') != std::string::npos
+                                 ? absl::StrCat("[", host, "]:", health_port)
+                                 : absl::StrCat(host, ":", health_port);
+  }
   options.grace_period = absl::GetFlag(FLAGS_grace_period);
   options.max_connection_age = absl::GetFlag(FLAGS_max_connection_age);
   if (absl::Status valid = options.Validate(); !valid.ok()) return valid;
@@ -53,7 +78,14 @@ int ServeUntilSignal(const std::string& name,
                      const std::function<void()>& on_stop) {
   absl::StatusOr<ServerOptions> options = ServerOptionsFromFlags();
   if (!options.ok()) return ExitWithError(name, options.status());
-  absl::StatusOr<std::unique_ptr<RpcServer>> server = RpcServer::Start(name, services, *options);
+  return ServeUntilSignal(name, services, *options, on_stop);
+}
+
+int ServeUntilSignal(const std::string& name,
+                     const std::vector<grpc::Service*>& services,
+                     const ServerOptions& options,
+                     const std::function<void()>& on_stop) {
+  absl::StatusOr<std::unique_ptr<RpcServer>> server = RpcServer::Start(name, services, options);
   if (!server.ok()) return ExitWithError(name, server.status());
   // One line on stdout that scripts can wait for.
   std::cout << name << " listening on port " << (*server)->port() << std::endl;

@@ -1,6 +1,7 @@
 // The part of every service's main that is the same for all: server flags
-// (--host, --port, --max_message_mb, --server_threads, --grace_period,
-// --max_connection_age), serving until SIGTERM/SIGINT, graceful shutdown.
+// (--host, --port, --max_message_mb, --server_threads, --max_queued_calls,
+// --grace_period, --max_connection_age, --tls_cert, --tls_key, --tls_ca,
+// --health_port), serving until SIGTERM/SIGINT, graceful shutdown.
 //
 //   int main(int argc, char** argv) {
 //     meshseek::rpc::BlockTerminationSignals();
@@ -28,6 +29,13 @@ absl::StatusOr<ServerOptions> ServerOptionsFromFlags();
 // the process exit code; errors are printed.
 int ServeUntilSignal(const std::string& name,
                      const std::vector<grpc::Service*>& services,
+                     const std::function<void()>& on_stop = nullptr);
+
+// The same with options the caller completed (the coordinator adds its
+// bearer token to ServerOptionsFromFlags()).
+int ServeUntilSignal(const std::string& name,
+                     const std::vector<grpc::Service*>& services,
+                     const ServerOptions& options,
                      const std::function<void()>& on_stop = nullptr);
 
 // Prints "<name>: <status>" to stderr and returns 2 (bad flags).

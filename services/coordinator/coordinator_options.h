@@ -3,6 +3,9 @@
 #ifndef MESHSEEK_SERVICES_COORDINATOR_COORDINATOR_OPTIONS_H_
 #define MESHSEEK_SERVICES_COORDINATOR_COORDINATOR_OPTIONS_H_
 
+#include <grpcpp/security/credentials.h>
+
+#include <memory>
 #include <string>
 
 #include "absl/status/status.h"
@@ -46,6 +49,11 @@ struct CoordinatorOptions {
   absl::Duration max_retry_backoff = absl::Minutes(1);
   /// Largest message to and from the services.
   int max_message_bytes = 64 << 20;
+  /// Credentials of the channels to the services (rpc::MakeChannelCredentials:
+  /// TLS, a client certificate for mutual TLS); null: plaintext. And the name
+  /// their certificates must carry when it is not the targets' host.
+  std::shared_ptr<grpc::ChannelCredentials> service_credentials;
+  std::string service_tls_name;
 
   absl::Status Validate() const;
 };

@@ -1,10 +1,13 @@
 // meshseek-coordinator: the API of meshseek (collections, ingest, build,
 // query, evaluation), orchestrating the worker and state services. Flags:
-// --data_dir, the four service targets, the work limits, and the server flags
-// (common/rpc/server_main.h).
+// --data_dir, the four service targets, the work limits, --token_file (bearer
+// token of the public API), the TLS flags of the channels to the services
+// (--service_tls_*), and the server flags (common/rpc/server_main.h).
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "common/rpc/client.h"
+#include "common/rpc/credentials.h"
 #include "common/rpc/server_main.h"
 #include "services/coordinator/coordinator_service.h"
 
@@ -34,6 +37,18 @@ ABSL_FLAG(absl::Duration, retry_backoff, kDefaults.retry_backoff,
 ABSL_FLAG(absl::Duration, max_retry_backoff, kDefaults.max_retry_backoff,
           "longest wait between a model's extraction attempts");
 
+ABSL_FLAG(std::string, token_file, "",
+          "file holding the bearer token every call but grpc.health.v1 must carry "
+          "(UNAUTHENTICATED otherwise); needs --tls_cert/--tls_key");
+ABSL_FLAG(std::string, service_tls_ca, "",
+          "PEM CA bundle the services' certificates are verified against; turns TLS on "
+          "for the channels to them");
+ABSL_FLAG(std::string, service_tls_cert, "",
+          "PEM client certificate presented to the services (mutual TLS)");
+ABSL_FLAG(std::string, service_tls_key, "", "PEM private key of --service_tls_cert");
+ABSL_FLAG(std::string, service_tls_name, "",
+          "name the services' certificates carry, when not the targets' host names");
+
 int main(int argc, char** argv) {
   meshseek::rpc::BlockTerminationSignals();
   absl::SetProgramUsageMessage("meshseek coordinator: collections, ingest, build, query, eval");
@@ -52,9 +67,24 @@ int main(int argc, char** argv) {
   options.model_attempts = absl::GetFlag(FLAGS_model_attempts);
   options.retry_backoff = absl::GetFlag(FLAGS_retry_backoff);
   options.max_retry_backoff = absl::GetFlag(FLAGS_max_retry_backoff);
+  meshseek::rpc::ClientSecurityOptions outbound;
+  outbound.tls.ca_file = absl::GetFlag(FLAGS_service_tls_ca);
+  outbound.tls.cert_file = absl::GetFlag(FLAGS_service_tls_cert);
+  outbound.tls.key_file = absl::GetFlag(FLAGS_service_tls_key);
+  outbound.server_name = absl::GetFlag(FLAGS_service_tls_name);
+  auto credentials = meshseek::rpc::MakeChannelCredentials(outbound);
+  if (!credentials.ok()) return meshseek::rpc::ExitWithError("coordinator", credentials.status());
+  options.service_credentials = *credentials;
+  options.service_tls_name = outbound.server_name;
+  auto server = meshseek::rpc::ServerOptionsFromFlags();
+  if (!server.ok()) return meshseek::rpc::ExitWithError("coordinator", server.status());
+  server->security.token_file = absl::GetFlag(FLAGS_token_file);
+  if (absl::Status valid = server->Validate(); !valid.ok()) {
+    return meshseek::rpc::ExitWithError("coordinator", valid);
+  }
   auto service = meshseek::CoordinatorService::Create(options);
   if (!service.ok()) return meshseek::rpc::ExitWithError("coordinator", service.status());
   meshseek::CoordinatorService* coordinator = service->get();
-  return meshseek::rpc::ServeUntilSignal("coordinator", {coordinator},
+  return meshseek::rpc::ServeUntilSignal("coordinator", {coordinator}, *server,
                                          [coordinator] { coordinator->Stop(); });
 }

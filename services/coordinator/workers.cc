@@ -19,6 +19,8 @@ Workers::Workers(const CoordinatorOptions& options, const std::atomic<bool>* sto
   retry_.attempts = options.call_attempts;
   rpc::ChannelOptions channel;
   channel.max_message_bytes = options.max_message_bytes;
+  channel.credentials = options.service_credentials;
+  channel.tls_server_name = options.service_tls_name;
   auto connect = [&](const std::string& target, const char* service) {
     channel.retry_service = service;
     return rpc::MakeChannel(target, channel);

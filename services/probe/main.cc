@@ -6,6 +6,8 @@
 //
 //   meshseek-probe --addr localhost:50051 [--service name] [--timeout 2s]
 //   meshseek-probe --addr localhost:50051 --list
+//   meshseek-probe --addr extract:50051 --tls_ca ca.pem [--tls_cert c.pem --tls_key c.key]
+// With TLS flags it connects as every meshseek client does (common/rpc/credentials.h).
 #include <iostream>
 
 #include "absl/flags/flag.h"
@@ -14,6 +16,7 @@
 #include "absl/time/time.h"
 #include <grpcpp/grpcpp.h>
 
+#include "common/rpc/credentials.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpc/reflection/v1alpha/reflection.grpc.pb.h"
 
@@ -21,6 +24,11 @@ ABSL_FLAG(std::string, addr, "localhost:50051", "server to check, host:port");
 ABSL_FLAG(std::string, service, "", "service name to check (empty: the whole server)");
 ABSL_FLAG(absl::Duration, timeout, absl::Seconds(2), "deadline of the check");
 ABSL_FLAG(bool, list, false, "list the server's services through reflection");
+ABSL_FLAG(std::string, tls_ca, "", "PEM CA bundle the server is verified against (turns TLS on)");
+ABSL_FLAG(std::string, tls_cert, "", "PEM client certificate, for servers that require one");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
+ABSL_FLAG(std::string, tls_server_name, "",
+          "name the server's certificate carries, when not the host of --addr");
 
 namespace {
 
@@ -49,7 +57,19 @@ int ListServices(const std::shared_ptr<grpc::Channel>& channel, grpc::ClientCont
 int main(int argc, char** argv) {
   absl::SetProgramUsageMessage("exits 0 when the gRPC server at --addr is SERVING");
   absl::ParseCommandLine(argc, argv);
-  auto channel = grpc::CreateChannel(absl::GetFlag(FLAGS_addr), grpc::InsecureChannelCredentials());
+  meshseek::rpc::ClientSecurityOptions security;
+  security.tls.ca_file = absl::GetFlag(FLAGS_tls_ca);
+  security.tls.cert_file = absl::GetFlag(FLAGS_tls_cert);
+  security.tls.key_file = absl::GetFlag(FLAGS_tls_key);
+  security.server_name = absl::GetFlag(FLAGS_tls_server_name);
+  auto credentials = meshseek::rpc::MakeChannelCredentials(security);
+  if (!credentials.ok()) {
+    std::cout << "bad flags: " << credentials.status().message() << "\n";
+    return 2;
+  }
+  grpc::ChannelArguments args;
+  if (!security.server_name.empty()) args.SetSslTargetNameOverride(security.server_name);
+  auto channel = grpc::CreateCustomChannel(absl::GetFlag(FLAGS_addr), *credentials, args);
   auto stub = grpc::health::v1::Health::NewStub(channel);
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() +

@@ -58,28 +58,42 @@ func checkPod(where string, spec corev1.PodSpec, p *problems, help map[string]st
 			p.add("%s: %v", where, err)
 			continue
 		}
-		port := ""
+		port, healthPort, tls := "", "", false
 		for _, a := range c.Args[1:] {
 			name, value, _ := strings.Cut(strings.TrimPrefix(a, "--"), "=")
 			if !strings.Contains(flags, "-"+name+" ") && !strings.Contains(flags, "-"+name+")") {
 				p.add("%s: %s has no flag --%s", where, c.Args[0], name)
 			}
-			if name == "port" {
+			switch name {
+			case "port":
 				port = value
+			case "health_port":
+				healthPort = value
+			case "tls_cert":
+				tls = true
 			}
 		}
 		ports := map[string]int32{}
 		for _, cp := range c.Ports {
 			ports[cp.Name] = cp.ContainerPort
-			if fmt.Sprint(cp.ContainerPort) != port {
-				p.add("%s: containerPort %d but the server listens on --port=%s", where, cp.ContainerPort, port)
+			if fmt.Sprint(cp.ContainerPort) != port && fmt.Sprint(cp.ContainerPort) != healthPort {
+				p.add("%s: containerPort %d but the server listens on --port=%s (--health_port=%s)",
+					where, cp.ContainerPort, port, healthPort)
 			}
+		}
+		// kubelet's gRPC probes speak plaintext only: a TLS server is probed
+		// on its plaintext health-only port.
+		probePort := port
+		if healthPort != "" {
+			probePort = healthPort
+		} else if tls {
+			p.add("%s: container %s serves TLS but has no --health_port for kubelet's plaintext gRPC probes", where, c.Name)
 		}
 		for _, probe := range []*corev1.Probe{c.ReadinessProbe, c.LivenessProbe} {
 			if probe == nil || probe.GRPC == nil {
 				p.add("%s: container %s needs gRPC readiness and liveness probes", where, c.Name)
-			} else if fmt.Sprint(probe.GRPC.Port) != port {
-				p.add("%s: probe on port %d, server on %s", where, probe.GRPC.Port, port)
+			} else if fmt.Sprint(probe.GRPC.Port) != probePort {
+				p.add("%s: probe on port %d, server's health on %s", where, probe.GRPC.Port, probePort)
 			}
 		}
 		if c.Resources.Requests.Cpu().IsZero() || c.Resources.Limits.Memory().IsZero() {
