@@ -24,6 +24,7 @@
 #include "common/pipeline/retrieval_pipeline.h"
 #include "common/rpc/client.h"
 #include "common/rpc/convert.h"
+#include "common/rpc/mesh_limit_flags.h"
 #include "common/rpc/server.h"
 #include "common/rpc/status.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"
@@ -75,9 +76,10 @@ class Session {
     auto session = std::make_unique<Session>();
     std::string address = absl::GetFlag(FLAGS_server);
     if (address.empty()) {
+      MESHSEEK_ASSIGN_OR_RETURN(const MeshReadOptions limits, rpc::MeshLimitsFromFlags());
       MESHSEEK_ASSIGN_OR_RETURN(session->stack_,
                                 EmbeddedStack::Start(absl::GetFlag(FLAGS_data_dir),
-                                                     absl::GetFlag(FLAGS_threads)));
+                                                     absl::GetFlag(FLAGS_threads), 0, {}, limits));
       address = session->stack_->coordinator_address();
     }
     rpc::ChannelOptions channel;
@@ -197,6 +199,7 @@ absl::StatusOr<v1::JobStatus> WaitForJob(v1::Coordinator::Stub* stub, const std:
 // was not acknowledged if the stream breaks), then waits for the jobs.
 absl::Status IngestModels(v1::Coordinator::Stub* stub, const std::string& collection,
                           const std::vector<ModelToIngest>& models) {
+  MESHSEEK_ASSIGN_OR_RETURN(const MeshReadOptions limits, rpc::MeshLimitsFromFlags());
   std::vector<bool> acked(models.size(), false);
   std::vector<std::string> jobs;
   std::size_t created = 0;
@@ -232,7 +235,7 @@ absl::Status IngestModels(v1::Coordinator::Stub* stub, const std::string& collec
         if (acked[i]) continue;
       }
       const ModelToIngest& m = models[i];
-      absl::StatusOr<TriangleMesh> mesh = ReadMesh(m.path);
+      absl::StatusOr<TriangleMesh> mesh = ReadMesh(m.path, nullptr, limits);
       if (!mesh.ok()) {
         stream->WritesDone();
         reader.join();
@@ -312,7 +315,8 @@ absl::Status RunQuery(const std::string& model_path) {
   const std::string collection = RequireCollection();
   if (collection.empty()) return absl::InvalidArgumentError("query needs --collection NAME");
   if (model_path.empty()) return absl::InvalidArgumentError("query needs a mesh file: meshseek query MODEL");
-  MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh, ReadMesh(model_path));
+  MESHSEEK_ASSIGN_OR_RETURN(const MeshReadOptions limits, rpc::MeshLimitsFromFlags());
+  MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh, ReadMesh(model_path, nullptr, limits));
   MESHSEEK_ASSIGN_OR_RETURN(auto session, Session::Open());
   v1::QueryRequest request;
   request.set_collection(collection);
@@ -379,9 +383,11 @@ absl::Status RunServe() {
   security.coordinator.tls.ca_file = absl::GetFlag(FLAGS_tls_ca);
   security.coordinator.token_file = absl::GetFlag(FLAGS_token_file);
   MESHSEEK_RETURN_IF_ERROR(security.coordinator.Validate());
+  MESHSEEK_ASSIGN_OR_RETURN(const MeshReadOptions limits, rpc::MeshLimitsFromFlags());
   MESHSEEK_ASSIGN_OR_RETURN(auto stack, EmbeddedStack::Start(absl::GetFlag(FLAGS_data_dir),
                                                              absl::GetFlag(FLAGS_threads),
-                                                             absl::GetFlag(FLAGS_port), security));
+                                                             absl::GetFlag(FLAGS_port), security,
+                                                             limits));
   std::printf("meshseek serving on %s (data in %s); Ctrl-C stops\n",
               stack->coordinator_address().c_str(), absl::GetFlag(FLAGS_data_dir).c_str());
   std::fflush(stdout);

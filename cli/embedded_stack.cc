@@ -10,7 +10,8 @@ absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(
     const std::string& data_dir,
     int threads,
     int coordinator_port,
-    const EmbeddedSecurity& security) {
+    const EmbeddedSecurity& security,
+    const MeshReadOptions& mesh_limits) {
   std::unique_ptr<EmbeddedStack> stack(new EmbeddedStack());
   const int cores = ResolveThreadCount(threads);
   rpc::ServerOptions server;
@@ -25,6 +26,8 @@ absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(
   };
   ExtractServiceOptions extract;
   extract.workers = cores;
+  extract.mesh_limits = mesh_limits;
+  stack->resample_ = std::make_unique<ResampleService>(mesh_limits);
   stack->extract_ = std::make_unique<ExtractService>(extract);
   CodebookServiceOptions codebook{data_dir + "/codebook", cores};
   MESHSEEK_ASSIGN_OR_RETURN(stack->codebook_, CodebookService::Create(codebook));
@@ -33,11 +36,12 @@ absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(
 
   CoordinatorOptions coordinator;
   coordinator.data_dir = data_dir + "/coordinator";
-  MESHSEEK_ASSIGN_OR_RETURN(coordinator.resample_target, serve("resample", &stack->resample_));
+  MESHSEEK_ASSIGN_OR_RETURN(coordinator.resample_target, serve("resample", stack->resample_.get()));
   MESHSEEK_ASSIGN_OR_RETURN(coordinator.extract_target, serve("extract", stack->extract_.get()));
   MESHSEEK_ASSIGN_OR_RETURN(coordinator.codebook_target, serve("codebook", stack->codebook_.get()));
   MESHSEEK_ASSIGN_OR_RETURN(coordinator.index_target, serve("index", stack->index_.get()));
   coordinator.max_in_flight = cores;
+  coordinator.mesh_limits = mesh_limits;
   rpc::ClientSecurityOptions outbound;
   outbound.tls = security.internal;
   MESHSEEK_ASSIGN_OR_RETURN(coordinator.service_credentials, rpc::MakeChannelCredentials(outbound));

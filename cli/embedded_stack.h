@@ -36,11 +36,13 @@ class EmbeddedStack {
   /// Starts the five services; the coordinator listens on `coordinator_port`
   /// (0: any free port) on 127.0.0.1, the others on free loopback ports.
   /// `threads`: extraction slots and coordinator in-flight models (<= 0: cores).
+  /// `mesh_limits` bound the meshes the services accept.
   static absl::StatusOr<std::unique_ptr<EmbeddedStack>> Start(
       const std::string& data_dir,
       int threads,
       int coordinator_port = 0,
-      const EmbeddedSecurity& security = {});
+      const EmbeddedSecurity& security = {},
+      const MeshReadOptions& mesh_limits = {});
   ~EmbeddedStack();
 
   /// "127.0.0.1:PORT" of the coordinator.
@@ -48,7 +50,7 @@ class EmbeddedStack {
 
  private:
   EmbeddedStack() = default;
-  ResampleService resample_;
+  std::unique_ptr<ResampleService> resample_;
   std::unique_ptr<ExtractService> extract_;
   std::unique_ptr<CodebookService> codebook_;
   std::unique_ptr<IndexService> index_;

@@ -25,6 +25,7 @@
 #include "common/features/depth_image.h"
 #include "common/geometry/enclosing_sphere.h"
 #include "common/geometry/mesh_io.h"
+#include "common/rpc/mesh_limit_flags.h"
 #include "common/geometry/principal_axes.h"
 #include "common/geometry/triangle_bvh.h"
 
@@ -162,7 +163,8 @@ absl::Status RunInspect(const std::string& model_path) {
   if (out_dir.empty()) return absl::InvalidArgumentError("inspect needs --out DIR");
   MESHSEEK_ASSIGN_OR_RETURN(const RetrievalPipelineOptions options, PipelineOptionsFromFlags());
   MeshReadReport report;
-  MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh, ReadMesh(model_path, &report));
+  MESHSEEK_ASSIGN_OR_RETURN(const MeshReadOptions limits, rpc::MeshLimitsFromFlags());
+  MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh, ReadMesh(model_path, &report, limits));
   MESHSEEK_ASSIGN_OR_RETURN(const LocalFeatures features,
                             ExtractLocalFeatures(mesh, options.extractor));
   std::error_code ec;

@@ -338,6 +338,19 @@ TEST_F(HostileInputTest, TheCliNamesTheBadFileAndNeitherHangsNorBalloons) {
     EXPECT_EQ(RunCli(absl::StrCat("inspect '", path, "' --out '", dir_, "/inspect'"), &output), 0)
         << file.name << ": " << output;
   }
+  // The limits are flags: a valid file over one is refused naming it.
+  const std::string tetrahedron = dir_ + "/files/tetrahedron.off";
+  std::string output;
+  EXPECT_NE(RunCli(absl::StrCat("inspect '", tetrahedron, "' --max_mesh_vertices=3 --out '", dir_,
+                                "/inspect'"),
+                   &output),
+            0);
+  EXPECT_THAT(output, HasSubstr("max_vertices (3)"));
+  EXPECT_NE(RunCli(absl::StrCat("inspect '", tetrahedron, "' --max_mesh_mb=0 --out '", dir_,
+                                "/inspect'"),
+                   &output),
+            0);
+  EXPECT_THAT(output, HasSubstr("--max_mesh_mb must be in [1, 1048576], got 0"));
 }
 
 }  // namespace

@@ -24,7 +24,7 @@ std::optional<MeshFormat> FormatOf(v1::MeshFormat format) {
 // extension; the content decides where it is recognisable (ParseMesh). The
 // default MeshReadOptions bound what the bytes may make the server allocate
 // (the message itself is bounded by gRPC's maximum message size).
-absl::StatusOr<TriangleMesh> ReadMeshFile(const v1::MeshFile& file) {
+absl::StatusOr<TriangleMesh> ReadMeshFile(const v1::MeshFile& file, const MeshReadOptions& limits) {
   const std::string name = file.name().empty() ? "mesh file" : file.name();
   std::optional<MeshFormat> declared = FormatOf(file.format());
   if (!declared) {
@@ -32,16 +32,17 @@ absl::StatusOr<TriangleMesh> ReadMeshFile(const v1::MeshFile& file) {
     if (!by_name.ok() && !DetectMeshFormat(file.data())) return by_name.status();
     if (by_name.ok()) declared = *by_name;
   }
-  return ParseMesh(file.data(), name, declared);
+  return ParseMesh(file.data(), name, declared, limits);
 }
 
 }  // namespace
 
-absl::StatusOr<TriangleMesh> MeshFromProto(const v1::MeshInput& input) {
+absl::StatusOr<TriangleMesh> MeshFromProto(const v1::MeshInput& input,
+                                           const MeshReadOptions& limits) {
   TriangleMesh mesh;
   switch (input.source_case()) {
     case v1::MeshInput::kFile: {
-      MESHSEEK_ASSIGN_OR_RETURN(mesh, ReadMeshFile(input.file()));
+      MESHSEEK_ASSIGN_OR_RETURN(mesh, ReadMeshFile(input.file(), limits));
       break;
     }
     case v1::MeshInput::kMesh: {

@@ -11,6 +11,7 @@
 #include "absl/status/statusor.h"
 #include "common/features/local_features.h"
 #include "common/geometry/mesh.h"
+#include "common/geometry/mesh_io.h"
 #include "common/geometry/point_graph.h"
 #include "common/pipeline/retrieval_pipeline.h"
 #include "common/search/sparse_histogram.h"
@@ -19,8 +20,10 @@
 namespace meshseek::rpc {
 
 // A mesh from arrays or from a file's bytes (read by the same readers as
-// ReadMesh; errors name the file by MeshFile.name). Validated (ValidateMesh).
-absl::StatusOr<TriangleMesh> MeshFromProto(const v1::MeshInput& input);
+// ReadMesh; errors name the file by MeshFile.name), within `limits`.
+// Validated (ValidateMesh).
+absl::StatusOr<TriangleMesh> MeshFromProto(const v1::MeshInput& input,
+                                           const MeshReadOptions& limits = {});
 void MeshToProto(const TriangleMesh& mesh, v1::Mesh* out);
 
 absl::StatusOr<LocalFeatures> FeaturesFromProto(const v1::LocalFeatures& features);

@@ -31,6 +31,7 @@ absl::Status CoordinatorOptions::Validate() const {
       call_deadline <= absl::ZeroDuration()) {
     return absl::InvalidArgumentError("coordinator: attempts and deadlines must be positive");
   }
+  MESHSEEK_RETURN_IF_ERROR(mesh_limits.Validate());
   if (model_attempts < 1 || model_attempts > 100) {
     return absl::InvalidArgumentError(
         absl::StrCat("coordinator: model_attempts must be in [1, 100], got ", model_attempts));

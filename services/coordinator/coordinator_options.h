@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "absl/time/time.h"
+#include "common/geometry/mesh_io.h"
 
 namespace meshseek {
 
@@ -47,6 +48,8 @@ struct CoordinatorOptions {
   int model_attempts = 5;
   absl::Duration retry_backoff = absl::Seconds(2);
   absl::Duration max_retry_backoff = absl::Minutes(1);
+  /// Bounds of a mesh a client sends (as a file or as arrays).
+  MeshReadOptions mesh_limits;
   /// Largest message to and from the services.
   int max_message_bytes = 64 << 20;
   /// Credentials of the channels to the services (rpc::MakeChannelCredentials:

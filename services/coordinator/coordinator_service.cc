@@ -161,7 +161,7 @@ absl::StatusOr<v1::IngestAck> CoordinatorService::AcceptModel(const v1::IngestRe
                                                    request.label().size(),
                                                    " bytes, more than 256"));
   }
-  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request.mesh());
+  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request.mesh(), options_.mesh_limits);
   if (!mesh.ok()) return Prefixed(mesh.status(), absl::StrCat("model ", request.model_id(), ": "));
   v1::Mesh stored;
   rpc::MeshToProto(*mesh, &stored);
@@ -249,7 +249,7 @@ grpc::Status CoordinatorService::Query(grpc::ServerContext*,
     return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
                         absl::StrCat("collection '", request->collection(), "' is not built yet"));
   }
-  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request->mesh());
+  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request->mesh(), options_.mesh_limits);
   if (!mesh.ok()) return rpc::ToGrpcStatus(Prefixed(mesh.status(), "query: "));
   v1::Mesh arrays;
   rpc::MeshToProto(*mesh, &arrays);

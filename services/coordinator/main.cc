@@ -8,6 +8,7 @@
 #include "absl/flags/usage.h"
 #include "common/rpc/client.h"
 #include "common/rpc/credentials.h"
+#include "common/rpc/mesh_limit_flags.h"
 #include "common/rpc/server_main.h"
 #include "services/coordinator/coordinator_service.h"
 
@@ -67,6 +68,9 @@ int main(int argc, char** argv) {
   options.model_attempts = absl::GetFlag(FLAGS_model_attempts);
   options.retry_backoff = absl::GetFlag(FLAGS_retry_backoff);
   options.max_retry_backoff = absl::GetFlag(FLAGS_max_retry_backoff);
+  auto limits = meshseek::rpc::MeshLimitsFromFlags();
+  if (!limits.ok()) return meshseek::rpc::ExitWithError("coordinator", limits.status());
+  options.mesh_limits = *limits;
   meshseek::rpc::ClientSecurityOptions outbound;
   outbound.tls.ca_file = absl::GetFlag(FLAGS_service_tls_ca);
   outbound.tls.cert_file = absl::GetFlag(FLAGS_service_tls_cert);

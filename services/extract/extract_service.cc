@@ -17,12 +17,13 @@ absl::Status ExtractServiceOptions::Validate() const {
   if (workers > 1024) {
     return absl::InvalidArgumentError(absl::StrCat("extract workers must be <= 1024, got ", workers));
   }
-  return absl::OkStatus();
+  return mesh_limits.Validate();
 }
 
 ExtractService::ExtractService(const ExtractServiceOptions& options)
     : workers_(options.workers > 0 ? options.workers
-                                   : std::max(1u, std::thread::hardware_concurrency())) {}
+                                   : std::max(1u, std::thread::hardware_concurrency())),
+      mesh_limits_(options.mesh_limits) {}
 
 grpc::Status ExtractService::Extract(grpc::ServerContext* context,
                                      const v1::ExtractRequest* request,
@@ -36,7 +37,7 @@ grpc::Status ExtractService::Extract(grpc::ServerContext* context,
   absl::StatusOr<RetrievalPipelineOptions> options =
       rpc::PipelineOptionsFromParams(request->params());
   if (!options.ok()) return fail(options.status());
-  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request->mesh());
+  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request->mesh(), mesh_limits_);
   if (!mesh.ok()) return fail(mesh.status());
   std::optional<PointGraph> graph;
   if (request->has_resampled() && options->extractor.method == FeatureMethod::kRldSift) {

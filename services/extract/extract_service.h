@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "absl/synchronization/mutex.h"
+#include "common/geometry/mesh_io.h"
 #include "meshseek/v1/extract.grpc.pb.h"
 
 namespace meshseek {
@@ -17,6 +18,8 @@ namespace meshseek {
 struct ExtractServiceOptions {
   /// Concurrent extractions; <= 0: one per core.
   int workers = 0;
+  /// Bounds of a mesh sent as a file (or as arrays).
+  MeshReadOptions mesh_limits;
 
   absl::Status Validate() const;
 };
@@ -31,6 +34,7 @@ class ExtractService final : public v1::Extract::Service {
 
  private:
   const int workers_;
+  const MeshReadOptions mesh_limits_;
   absl::Mutex mutex_;
   int busy_ ABSL_GUARDED_BY(mutex_) = 0;
 };

@@ -1,7 +1,8 @@
 // meshseek-resample: the stateless resample worker. Flags: the server flags
-// (common/rpc/server_main.h).
+// (common/rpc/server_main.h) and the mesh limits (common/rpc/mesh_limit_flags.h).
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "common/rpc/mesh_limit_flags.h"
 #include "common/rpc/server_main.h"
 #include "services/resample/resample_service.h"
 
@@ -9,6 +10,8 @@ int main(int argc, char** argv) {
   meshseek::rpc::BlockTerminationSignals();
   absl::SetProgramUsageMessage("meshseek resample worker: mesh -> Sobol point graph");
   absl::ParseCommandLine(argc, argv);
-  meshseek::ResampleService service;
+  auto limits = meshseek::rpc::MeshLimitsFromFlags();
+  if (!limits.ok()) return meshseek::rpc::ExitWithError("resample", limits.status());
+  meshseek::ResampleService service(*limits);
   return meshseek::rpc::ServeUntilSignal("resample", {&service});
 }

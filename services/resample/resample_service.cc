@@ -14,7 +14,7 @@ grpc::Status ResampleService::Resample(grpc::ServerContext*,
   limits.num_samples = request->num_samples();
   limits.neighbors = request->neighbors();
   if (absl::Status valid = limits.Validate(); !valid.ok()) return rpc::ToGrpcStatus(valid);
-  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request->mesh());
+  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request->mesh(), mesh_limits_);
   if (!mesh.ok()) return rpc::ToGrpcStatus(mesh.status());
   absl::StatusOr<PointGraph> graph =
       ResampleSurfaceGraph(*mesh, request->num_samples(), request->neighbors());

@@ -3,15 +3,22 @@
 #ifndef MESHSEEK_SERVICES_RESAMPLE_RESAMPLE_SERVICE_H_
 #define MESHSEEK_SERVICES_RESAMPLE_RESAMPLE_SERVICE_H_
 
+#include "common/geometry/mesh_io.h"
 #include "meshseek/v1/resample.grpc.pb.h"
 
 namespace meshseek {
 
 class ResampleService final : public v1::Resample::Service {
  public:
+  /// `mesh_limits` bound a mesh sent as a file (or as arrays).
+  explicit ResampleService(const MeshReadOptions& mesh_limits = {}) : mesh_limits_(mesh_limits) {}
+
   grpc::Status Resample(grpc::ServerContext* context,
                         const v1::ResampleRequest* request,
                         v1::ResampleResponse* response) override;
+
+ private:
+  const MeshReadOptions mesh_limits_;
 };
 
 }  // namespace meshseek
