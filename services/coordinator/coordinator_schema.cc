@@ -31,14 +31,16 @@ constexpr const char* kSchema1 = R"sql(
 
 // Version 2: attempts and backoff per model (retry_at in Unix microseconds,
 // 0 = now), and indexes on what is scanned: the dispatchers' claim (state,
-// retry_at), a job's counts (job_id), a collection's models in order.
+// retry_at), a job's counts (job_id), a collection's models in order, all or
+// in one state (ListModels pages).
 constexpr const char* kSchema2 = R"sql(
   ALTER TABLE models ADD COLUMN attempts INTEGER NOT NULL DEFAULT 0;
   ALTER TABLE models ADD COLUMN retry_at INTEGER NOT NULL DEFAULT 0;
   DROP INDEX IF EXISTS models_by_state;
   CREATE INDEX models_claim ON models (state, retry_at);
   CREATE INDEX models_by_job ON models (job_id, state);
-  CREATE INDEX models_by_collection ON models (collection, state, ordinal);
+  CREATE INDEX models_in_order ON models (collection, ordinal);
+  CREATE INDEX models_by_state_in_order ON models (collection, state, ordinal);
 )sql";
 
 // Version 1 fingerprinted meshes with the mistaken FNV basis: recompute them,
