@@ -15,6 +15,17 @@
 #ifndef MESHSEEK_COMMON_BASE_CPU_FEATURES_H_
 #define MESHSEEK_COMMON_BASE_CPU_FEATURES_H_
 
+// Compiles the function it precedes for AVX-512 and AVX2 as well as the
+// baseline, the loader picking one for the CPU (GCC's and clang's
+// target_clones). Clang before 15 names the dispatcher of such a function
+// "<name>.ifunc", so that a call from another file does not link; there
+// (the fuzz build) the baseline alone is compiled.
+#if defined(__clang__) && __clang_major__ < 15
+#define MESHSEEK_TARGET_CLONES_AVX
+#else
+#define MESHSEEK_TARGET_CLONES_AVX __attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+
 namespace meshseek {
 
 enum class SimdLevel {
