@@ -52,6 +52,26 @@ TEST(ConvertTest, MeshFileBytesAreReadByTheFileReaders) {
   EXPECT_EQ(MeshFromProto(input).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
+TEST(ConvertTest, AnOffFileNamedObjWithCommentsBeforeItsHeaderIsReadByItsContent) {
+  // What a user's Ingest sends when an exporter wrote OFF under a .obj name:
+  // read as OFF (the content decides), not "mesh has no faces".
+  v1::MeshInput input;
+  input.mutable_file()->set_name("chair.obj");
+  input.mutable_file()->set_data("# exported by hand\n\n# second comment\nOFF\n4 4 0\n0 0 0\n"
+                                 "1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  auto mesh = MeshFromProto(input);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->triangles.size(), 4u);
+  // Declared OBJ by the format tag as well: the content still decides.
+  input.mutable_file()->set_format(v1::MESH_FORMAT_OBJ);
+  EXPECT_TRUE(MeshFromProto(input).ok());
+  // A bare OFF header under that name is refused naming the file.
+  input.mutable_file()->set_data("OFF\n");
+  const absl::Status bare = MeshFromProto(input).status();
+  EXPECT_EQ(bare.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(bare.message()), ::testing::HasSubstr("chair.obj"));
+}
+
 TEST(ConvertTest, FeaturesRoundTripAndWrongDescriptorSizesAreRejected) {
   LocalFeatures features;
   features.keypoints.resize(2);
