@@ -17,10 +17,14 @@
 
 // Compiles the function it precedes for AVX-512 and AVX2 as well as the
 // baseline, the loader picking one for the CPU (GCC's and clang's
-// target_clones). Clang before 15 names the dispatcher of such a function
-// "<name>.ifunc", so that a call from another file does not link; there
-// (the fuzz build) the baseline alone is compiled.
-#if defined(__clang__) && __clang_major__ < 15
+// target_clones). The baseline alone is compiled where that cannot work:
+// clang before 15 names the dispatcher "<name>.ifunc", so that a call from
+// another file does not link (the fuzz build); under ThreadSanitizer the
+// dispatcher is instrumented and runs while the loader relocates, before the
+// TSan runtime exists, and crashes (the TSan build).
+#if defined(__SANITIZE_THREAD__)
+#define MESHSEEK_TARGET_CLONES_AVX
+#elif defined(__clang__) && (__clang_major__ < 15 || __has_feature(thread_sanitizer))
 #define MESHSEEK_TARGET_CLONES_AVX
 #else
 #define MESHSEEK_TARGET_CLONES_AVX __attribute__((target_clones("avx512f", "avx2", "default")))
