@@ -20,6 +20,7 @@ if [ "${1:-}" != "--build-only" ]; then
     ccache python3                                   # faster rebuilds; python3 runs the reference evaluator
     libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
     libfaiss-dev libopenblas-dev                     # yardsticks of bench/codebook_benchmark (Faiss on OpenBLAS)
+    clang llvm                                       # libFuzzer harnesses (tests/fuzz), llvm-symbolizer for sanitizer reports
   )
 fi
 
