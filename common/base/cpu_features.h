@@ -22,9 +22,15 @@
 // another file does not link (the fuzz build); under ThreadSanitizer the
 // dispatcher is instrumented and runs while the loader relocates, before the
 // TSan runtime exists, and crashes (the TSan build).
-#if defined(__SANITIZE_THREAD__)
-#define MESHSEEK_TARGET_CLONES_AVX
-#elif defined(__clang__) && (__clang_major__ < 15 || __has_feature(thread_sanitizer))
+// (__has_feature is clang's: GCC cannot even parse it, hence the nesting.)
+#if defined(__clang__)
+#if __clang_major__ < 15 || __has_feature(thread_sanitizer)
+#define MESHSEEK_NO_TARGET_CLONES 1
+#endif
+#elif defined(__SANITIZE_THREAD__)
+#define MESHSEEK_NO_TARGET_CLONES 1
+#endif
+#if defined(MESHSEEK_NO_TARGET_CLONES)
 #define MESHSEEK_TARGET_CLONES_AVX
 #else
 #define MESHSEEK_TARGET_CLONES_AVX __attribute__((target_clones("avx512f", "avx2", "default")))
