@@ -15,6 +15,27 @@
 #ifndef MESHSEEK_COMMON_BASE_CPU_FEATURES_H_
 #define MESHSEEK_COMMON_BASE_CPU_FEATURES_H_
 
+// Compiles the function it precedes for AVX-512 and AVX2 as well as the
+// baseline, the loader picking one for the CPU (GCC's and clang's
+// target_clones). The baseline alone is compiled where that cannot work:
+// clang before 15 names the dispatcher "<name>.ifunc", so that a call from
+// another file does not link (the fuzz build); under ThreadSanitizer the
+// dispatcher is instrumented and runs while the loader relocates, before the
+// TSan runtime exists, and crashes (the TSan build).
+// (__has_feature is clang's: GCC cannot even parse it, hence the nesting.)
+#if defined(__clang__)
+#if __clang_major__ < 15 || __has_feature(thread_sanitizer)
+#define MESHSEEK_NO_TARGET_CLONES 1
+#endif
+#elif defined(__SANITIZE_THREAD__)
+#define MESHSEEK_NO_TARGET_CLONES 1
+#endif
+#if defined(MESHSEEK_NO_TARGET_CLONES)
+#define MESHSEEK_TARGET_CLONES_AVX
+#else
+#define MESHSEEK_TARGET_CLONES_AVX __attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+
 namespace meshseek {
 
 enum class SimdLevel {

@@ -10,7 +10,7 @@
 
 namespace meshseek {
 
-absl::StatusOr<std::string> ReadFileToString(const std::string& path) {
+absl::StatusOr<std::string> ReadFileToString(const std::string& path, uint64_t max_bytes) {
   // A folder opens like a file on Linux and then reads as empty, which would
   // surface as a misleading "empty file" error downstream.
   std::error_code ec;
@@ -21,6 +21,26 @@ absl::StatusOr<std::string> ReadFileToString(const std::string& path) {
   if (!in) {
     return absl::NotFoundError(
         absl::StrCat(path, ": cannot open file (", std::strerror(errno), ")"));
+  }
+  if (max_bytes != std::numeric_limits<uint64_t>::max()) {
+    // The size is checked first, and the read is capped too: a pipe or a file
+    // that grows while it is read has no trustworthy size.
+    const uint64_t size = std::filesystem::file_size(path, ec);
+    if (!ec && size > max_bytes) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat(path, ": ", size, " bytes, more than the limit of ", max_bytes));
+    }
+    std::string contents;
+    char buffer[1 << 16];
+    while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+      if (contents.size() + static_cast<uint64_t>(in.gcount()) > max_bytes) {
+        return absl::ResourceExhaustedError(
+            absl::StrCat(path, ": more than the limit of ", max_bytes, " bytes"));
+      }
+      contents.append(buffer, static_cast<std::size_t>(in.gcount()));
+    }
+    if (in.bad()) return absl::DataLossError(absl::StrCat(path, ": read failed"));
+    return contents;
   }
   std::ostringstream contents;
   contents << in.rdbuf();

@@ -2,6 +2,8 @@
 #ifndef MESHSEEK_COMMON_BASE_FILE_IO_H_
 #define MESHSEEK_COMMON_BASE_FILE_IO_H_
 
+#include <cstdint>
+#include <limits>
 #include <string>
 
 #include "absl/status/status.h"
@@ -11,9 +13,12 @@
 namespace meshseek {
 
 // The bytes of the file at `path`. NotFound ("<path>: cannot open file (<why>)")
-// when it cannot be opened, InvalidArgument when it is a folder, DataLoss when
-// reading fails part-way.
-absl::StatusOr<std::string> ReadFileToString(const std::string& path);
+// when it cannot be opened, InvalidArgument when it is a folder,
+// ResourceExhausted ("<path>: N bytes, more than the limit of M") when it is
+// larger than `max_bytes` (checked before anything is read, so that a huge or
+// endless file cannot exhaust memory), DataLoss when reading fails part-way.
+absl::StatusOr<std::string> ReadFileToString(
+    const std::string& path, uint64_t max_bytes = std::numeric_limits<uint64_t>::max());
 
 // Replaces the file at `path` with `contents`. PermissionDenied when it cannot
 // be created, DataLoss when writing fails (disk full).

@@ -63,7 +63,11 @@ bool IsToken(const std::string& s) {
 }  // namespace
 
 absl::StatusOr<ClassFile> ReadPsbClassFile(const std::string& path) {
-  MESHSEEK_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  MESHSEEK_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path, kMaxClassFileBytes));
+  return ParsePsbClassFile(text, path);
+}
+
+absl::StatusOr<ClassFile> ParsePsbClassFile(absl::string_view text, const std::string& path) {
   TokenLines in(text);
   auto error = [&path, &in](absl::string_view message) {
     return absl::InvalidArgumentError(absl::StrCat(path, ":", in.line_no(), ": ", message));

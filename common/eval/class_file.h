@@ -17,11 +17,13 @@
 #ifndef MESHSEEK_COMMON_EVAL_CLASS_FILE_H_
 #define MESHSEEK_COMMON_EVAL_CLASS_FILE_H_
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 
 namespace meshseek {
 
@@ -44,11 +46,16 @@ struct ClassFile {
   std::vector<std::string> labels;
 };
 
+// Largest class file ReadPsbClassFile reads (a million models take about
+// 10 MB); a wrong path cannot fill memory.
+inline constexpr uint64_t kMaxClassFileBytes = uint64_t{256} << 20;
+
 // Reads a "PSB 1" class file. Whitespace separates tokens, blank lines are
 // skipped and CRLF line ends are tolerated; otherwise the layout must be as
 // above, one class header or one model id per line.
 // Errors (messages start with "<path>:<line>: " and quote the bad value):
 //   NotFound         the file cannot be opened;
+//   ResourceExhausted the file is larger than kMaxClassFileBytes;
 //   InvalidArgument  a first line other than "PSB 1"; a bad counts line; a
 //                    bad class header (not 3 tokens, count not a non-negative
 //                    integer, name "0", name declared twice, parent not
@@ -57,6 +64,8 @@ struct ClassFile {
 //                    or models than the header says (truncated file), or
 //                    content after the last class.
 absl::StatusOr<ClassFile> ReadPsbClassFile(const std::string& path);
+// The same from the file's text held in memory; `path` names it in errors.
+absl::StatusOr<ClassFile> ParsePsbClassFile(absl::string_view text, const std::string& path);
 
 // Writes `class_file` in "PSB 1" format from `classes` (an empty parent is
 // written as "0"). If `model_ids` or `labels` is non-empty it must equal the

@@ -74,6 +74,26 @@ TEST(ClassFileTest, MissingFileIsNotFoundAndAFolderIsRejected) {
   EXPECT_THAT(ReadPsbClassFile(dir).status().message(), HasSubstr(dir + ": is a folder"));
 }
 
+TEST(ClassFileTest, AFileLargerThanTheLimitIsRefusedBeforeItIsRead) {
+  const std::string path = TestDir() + "/huge.cla";
+  std::ofstream(path) << "PSB 1\n";
+  std::filesystem::resize_file(path, kMaxClassFileBytes + 1);  // sparse
+  const auto file = ReadPsbClassFile(path);
+  EXPECT_EQ(file.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(file.status().message(), HasSubstr(path + ": 268435457 bytes, more than the limit"));
+}
+
+TEST(ClassFileTest, ParseFromMemoryNamesTheGivenPath) {
+  const auto file = ParsePsbClassFile("PSB 1\n1 2\nchair 0 2\nm1\nm2\n", "mem.cla");
+  ASSERT_TRUE(file.ok()) << file.status();
+  EXPECT_THAT(file->model_ids, ElementsAre("m1", "m2"));
+  // Counts in the billions cost nothing: the lines run out first.
+  EXPECT_THAT(ParsePsbClassFile("PSB 1\n4000000000 4000000000\nc 0 4000000000\nm1\n", "mem.cla")
+                  .status()
+                  .message(),
+              HasSubstr("mem.cla:4: file ends inside class 'c'"));
+}
+
 TEST(ClassFileTest, ErrorsNameFileLineAndValue) {
   EXPECT_THAT(ReadError(""), HasSubstr("c.cla:1: empty file"));
   EXPECT_THAT(ReadError("PSB 2\n1 1\n"), HasSubstr("c.cla:1: expected 'PSB 1', got 'PSB 2'"));

@@ -91,7 +91,12 @@ std::string QuoteCsvField(const std::string& field) {
 }  // namespace
 
 absl::StatusOr<std::vector<ManifestEntry>> ReadManifest(const std::string& path) {
-  MESHSEEK_ASSIGN_OR_RETURN(std::string text, ReadFileToString(path));
+  MESHSEEK_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path, kMaxManifestBytes));
+  return ParseManifest(text, path);
+}
+
+absl::StatusOr<std::vector<ManifestEntry>> ParseManifest(absl::string_view text,
+                                                         const std::string& path) {
   absl::string_view contents = text;
   absl::ConsumePrefix(&contents, kUtf8Bom);
   const std::string folder = std::filesystem::path(path).parent_path().string();

@@ -21,11 +21,13 @@
 #ifndef MESHSEEK_COMMON_EVAL_MANIFEST_H_
 #define MESHSEEK_COMMON_EVAL_MANIFEST_H_
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 
 namespace meshseek {
 
@@ -39,14 +41,24 @@ struct ManifestEntry {
   int line = 0;  // 1-based line in the manifest it was read from (0: not read from a file)
 };
 
+// Largest manifest ReadManifest reads: a million models take about 50 MB, and
+// the limit keeps a wrong path (a mesh archive, /dev/zero) from filling memory.
+inline constexpr uint64_t kMaxManifestBytes = uint64_t{256} << 20;
+
 // Reads the manifest at `path`, rows in file order.
 // Errors (each message starts with "<path>:<line>: " and quotes the bad value):
 //   NotFound         the file cannot be opened;
+//   ResourceExhausted the file is larger than kMaxManifestBytes;
 //   InvalidArgument  no header, a header without id/class/path or with a
 //                    repeated column, a row with the wrong number of fields, an
 //                    unterminated quote, an empty id/class/path, a duplicate id
 //                    (naming both lines), no rows at all.
 absl::StatusOr<std::vector<ManifestEntry>> ReadManifest(const std::string& path);
+
+// The same from the manifest's text held in memory: `path` names it in errors
+// and its folder resolves relative paths, as in ReadManifest.
+absl::StatusOr<std::vector<ManifestEntry>> ParseManifest(absl::string_view text,
+                                                         const std::string& path);
 
 // Writes `entries` as "id,class,path" rows (LF line ends) with each path as
 // given; fields holding a comma, a quote or outer spaces are quoted, so that

@@ -106,6 +106,31 @@ TEST(ManifestTest, FolderIsRejected) {
   EXPECT_THAT(ReadManifest(dir).status().message(), HasSubstr(dir + ": is a folder"));
 }
 
+TEST(ManifestTest, AFileLargerThanTheLimitIsRefusedBeforeItIsRead) {
+  // A sparse file: its size is what counts, nothing of it needs to exist.
+  const std::string path = TestDir() + "/huge.csv";
+  std::ofstream(path) << "id,class,path\n";
+  std::filesystem::resize_file(path, kMaxManifestBytes + 1);
+  const auto entries = ReadManifest(path);
+  EXPECT_EQ(entries.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(entries.status().message(), HasSubstr(path + ": 268435457 bytes, more than the limit"));
+}
+
+TEST(ManifestTest, ParseFromMemoryEqualsReadingTheFile) {
+  const std::string text = "id,class,path\nm1,a,x.off\nm2,b,/abs/y.off\n";
+  const std::string path = WriteFile(TestDir(), "m.csv", text);
+  const auto read = ReadManifest(path);
+  const auto parsed = ParseManifest(text, path);
+  ASSERT_TRUE(read.ok() && parsed.ok()) << read.status() << parsed.status();
+  ASSERT_EQ(read->size(), parsed->size());
+  for (std::size_t i = 0; i < read->size(); ++i) {
+    EXPECT_EQ((*read)[i].path, (*parsed)[i].path);
+    EXPECT_EQ((*read)[i].line, (*parsed)[i].line);
+  }
+  EXPECT_THAT(ParseManifest("id,class,path\nm1,,x\n", "in/memory.csv").status().message(),
+              HasSubstr("in/memory.csv:2: empty class for id 'm1'"));
+}
+
 TEST(ManifestTest, ErrorsNameFileLineAndValue) {
   EXPECT_THAT(ReadError(""), HasSubstr("m.csv:1: no header"));
   EXPECT_THAT(ReadError("\n\n"), HasSubstr("m.csv:1: no header"));

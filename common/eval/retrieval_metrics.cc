@@ -186,13 +186,16 @@ std::string FormatMetricsTable(const RetrievalMetrics& metrics) {
       absl::StrCat(metrics.queries, " queries in ", metrics.classes, " classes (percent)\n");
   out.append(8, ' ');
   for (std::size_t c = 0; c < std::size(kColumns); ++c) {
-    absl::StrAppendFormat(&out, c == 0 ? "%8s" : " %8s", kColumns[c].key);
+    // The format must be a literal for clang's compile-time format check.
+    if (c > 0) out.push_back(' ');
+    absl::StrAppendFormat(&out, "%8s", kColumns[c].key);
   }
   out.push_back('\n');
   auto append_row = [&out](const char* name, const RetrievalScores& scores) {
     absl::StrAppendFormat(&out, "%7s ", name);
     for (std::size_t c = 0; c < std::size(kColumns); ++c) {
-      absl::StrAppendFormat(&out, c == 0 ? "%8.1f" : " %8.1f", 100.0 * (scores.*kColumns[c].field));
+      if (c > 0) out.push_back(' ');
+      absl::StrAppendFormat(&out, "%8.1f", 100.0 * (scores.*kColumns[c].field));
     }
     out.push_back('\n');
   };

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "common/base/cpu_features.h"
 
 namespace meshseek {
 
@@ -38,7 +39,7 @@ DepthImageRenderer::DepthImageRenderer(const TriangleMesh& mesh,
 // Compiled for AVX-512 and AVX2 as well, picked at run time (the projection
 // and culling loop vectorises wider); the same operations per lane, so the
 // same images (the module keeps multiply and add apart: CMakeLists.txt).
-__attribute__((target_clones("avx512f", "avx2", "default"))) void DepthImageRenderer::RenderPair(
+MESHSEEK_TARGET_CLONES_AVX void DepthImageRenderer::RenderPair(
     const ViewFrame& frame, DepthImage* front, DepthImage* back) {
   const int size = options_.image_size;
   const double s = frame.radius;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "common/base/cpu_features.h"
 
 namespace meshseek {
 namespace {
@@ -223,7 +224,7 @@ void DepthSiftDescriber::Prepare(int size) {
 
 // Compiled for AVX-512 and AVX2 as well, picked at run time: the blur and
 // gradient loops vectorise wider, with the same operations per lane.
-__attribute__((target_clones("avx512f", "avx2", "default"))) void
+MESHSEEK_TARGET_CLONES_AVX void
 DepthSiftDescriber::ComputeSamples(const DepthImage& image) {
   const int size = size_;
   float lo = 0, hi = 2 * image.support_radius;

@@ -36,9 +36,14 @@ absl::Status ValidatePointGraph(const PointGraph& graph) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
       return absl::InvalidArgumentError(absl::StrCat("point graph: point ", i, " is not finite"));
     }
-    if (graph.offsets[i + 1] < graph.offsets[i]) {
+    // Each offset is checked against the neighbour count as well as against
+    // the previous one: offsets[n] bounds the last offset only, and a later
+    // decrease would come too late to stop the reads below.
+    if (graph.offsets[i + 1] < graph.offsets[i] ||
+        graph.offsets[i + 1] > graph.neighbors.size()) {
       return absl::InvalidArgumentError(
-          absl::StrCat("point graph: offsets decrease at point ", i));
+          absl::StrCat("point graph: offsets decrease at point ", i, " (", graph.offsets[i], " to ",
+                       graph.offsets[i + 1], ", ", graph.neighbors.size(), " neighbours)"));
     }
     for (uint32_t k = graph.offsets[i]; k < graph.offsets[i + 1]; ++k) {
       if (graph.neighbors[k] >= n || graph.neighbors[k] == i) {

@@ -16,6 +16,7 @@
 #include "common/eval/distance_matrix.h"
 #include "common/geometry/mesh_io.h"
 #include "common/search/kl_inverted_index.h"
+#include "common/search/sparse_histogram.h"
 
 namespace meshseek {
 namespace {
@@ -38,6 +39,15 @@ RetrievalPipelineOptions::RetrievalPipelineOptions() {
 absl::Status RetrievalPipelineOptions::Validate() const {
   MESHSEEK_RETURN_IF_ERROR(extractor.Validate());
   MESHSEEK_RETURN_IF_ERROR(kmeans.Validate());
+  // Histograms of a larger vocabulary would be refused by the index
+  // (SparseHistogram::Validate) only after the whole codebook was learnt.
+  if (kmeans.num_centroids > static_cast<int64_t>(kMaxVocabulary)) {
+    return absl::InvalidArgumentError(absl::StrCat("vocabulary size V = ",
+                                                   kmeans.num_centroids,
+                                                   " is more than the index's limit of ",
+                                                   kMaxVocabulary,
+                                                   " words"));
+  }
   return kl.Validate();
 }
 

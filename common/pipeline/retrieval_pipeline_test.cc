@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "common/geometry/test_meshes.h"
+#include "common/search/sparse_histogram.h"
 #include "common/synth/synthetic_benchmark.h"
 
 namespace meshseek {
@@ -23,6 +24,15 @@ TEST(RetrievalPipelineOptionsTest, DefaultsArePinnedAndValid) {
   EXPECT_EQ(options.extractor.dld.descriptor.orientation, ImageOrientation::kDominant);
   const std::string json = options.ToJson().Dump();
   EXPECT_NE(json.find("\"vocabulary_size_V\": 2000"), std::string::npos) << json;
+}
+
+TEST(RetrievalPipelineOptionsTest, AVocabularyTheIndexCannotHoldIsRefused) {
+  RetrievalPipelineOptions options;
+  options.kmeans.num_centroids = static_cast<int>(kMaxVocabulary);
+  EXPECT_TRUE(options.Validate().ok());
+  options.kmeans.num_centroids = static_cast<int>(kMaxVocabulary) + 1;
+  EXPECT_EQ(options.Validate().message(),
+            "vocabulary size V = 65537 is more than the index's limit of 65536 words");
 }
 
 // A model and a rotated, scaled and moved copy of it get nearly the same

@@ -1,5 +1,7 @@
 #include "common/rpc/convert.h"
 
+#include <cmath>
+#include <cstdint>
 #include <optional>
 
 #include "absl/strings/str_cat.h"
@@ -51,6 +53,16 @@ absl::StatusOr<TriangleMesh> MeshFromProto(const v1::MeshInput& input,
         return absl::InvalidArgumentError(
             absl::StrCat("mesh: ", m.vertices_size(), " vertex values and ", m.triangles_size(),
                          " triangle indices; both must be multiples of 3"));
+      }
+      // The same limits as a mesh sent as a file: arrays are already in
+      // memory, but every later stage allocates a multiple of their size.
+      const MeshReadOptions limits;
+      if (static_cast<uint64_t>(m.vertices_size() / 3) > limits.max_vertices ||
+          static_cast<uint64_t>(m.triangles_size() / 3) > limits.max_triangles) {
+        return absl::ResourceExhaustedError(absl::StrCat(
+            "mesh: ", m.vertices_size() / 3, " vertices and ", m.triangles_size() / 3,
+            " triangles, more than the limits of ", limits.max_vertices, " (max_vertices) and ",
+            limits.max_triangles, " (max_triangles)"));
       }
       mesh.vertices.resize(m.vertices_size() / 3);
       for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
@@ -117,6 +129,15 @@ absl::StatusOr<LocalFeatures> FeaturesFromProto(const v1::LocalFeatures& f) {
       k.up = Vec3f(f.ups(3 * i), f.ups(3 * i + 1), f.ups(3 * i + 2));
       k.scale = f.scales(i);
       k.level = f.levels(i);
+      // Keypoints are drawn and stored; a NaN would travel silently.
+      if (!IsFinite(k.position) || !IsFinite(k.view) || !IsFinite(k.up) ||
+          !std::isfinite(k.scale) || k.scale < 0 || k.level < 0) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "local features: keypoint ", i, " has a non-finite or negative value (position ",
+            k.position.x, " ", k.position.y, " ", k.position.z, ", view ", k.view.x, " ",
+            k.view.y, " ", k.view.z, ", up ", k.up.x, " ", k.up.y, " ", k.up.z, ", scale ",
+            k.scale, ", level ", k.level, ")"));
+      }
     }
   }
   return features;

@@ -1,5 +1,6 @@
 #include "common/rpc/convert.h"
 
+#include <limits>
 #include <string>
 
 #include "common/geometry/test_meshes.h"
@@ -51,6 +52,26 @@ TEST(ConvertTest, MeshFileBytesAreReadByTheFileReaders) {
   EXPECT_EQ(MeshFromProto(input).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
+TEST(ConvertTest, AnOffFileNamedObjWithCommentsBeforeItsHeaderIsReadByItsContent) {
+  // What a user's Ingest sends when an exporter wrote OFF under a .obj name:
+  // read as OFF (the content decides), not "mesh has no faces".
+  v1::MeshInput input;
+  input.mutable_file()->set_name("chair.obj");
+  input.mutable_file()->set_data("# exported by hand\n\n# second comment\nOFF\n4 4 0\n0 0 0\n"
+                                 "1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  auto mesh = MeshFromProto(input);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->triangles.size(), 4u);
+  // Declared OBJ by the format tag as well: the content still decides.
+  input.mutable_file()->set_format(v1::MESH_FORMAT_OBJ);
+  EXPECT_TRUE(MeshFromProto(input).ok());
+  // A bare OFF header under that name is refused naming the file.
+  input.mutable_file()->set_data("OFF\n");
+  const absl::Status bare = MeshFromProto(input).status();
+  EXPECT_EQ(bare.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(bare.message()), ::testing::HasSubstr("chair.obj"));
+}
+
 TEST(ConvertTest, FeaturesRoundTripAndWrongDescriptorSizesAreRejected) {
   LocalFeatures features;
   features.keypoints.resize(2);
@@ -85,6 +106,53 @@ TEST(ConvertTest, GraphsAreCheckedOnArrival) {
   EXPECT_EQ(back->neighbors, graph.neighbors);
   proto.set_neighbors(0, 5);
   EXPECT_EQ(GraphFromProto(proto).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(ConvertTest, GraphOffsetsBeyondTheNeighboursAreRefusedBeforeTheyAreRead) {
+  // offsets[n] equals the neighbour count, so only the later decrease shows
+  // that offsets[1] points past the neighbours: it used to be read first.
+  v1::PointGraph proto;
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f}) proto.add_positions(v);
+  for (uint32_t o : {0u, 100u, 1u}) proto.add_offsets(o);
+  proto.add_neighbors(1);
+  const absl::Status status = GraphFromProto(proto).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()),
+              ::testing::HasSubstr("offsets decrease at point 0 (0 to 100, 1 neighbours)"));
+}
+
+TEST(ConvertTest, NonFiniteKeypointsAreRefusedNamingTheKeypoint) {
+  LocalFeatures features;
+  features.keypoints.resize(2);
+  features.keypoints[1].scale = std::numeric_limits<float>::quiet_NaN();
+  features.descriptors.assign(2 * kSiftDimension, 1);
+  v1::LocalFeatures proto;
+  FeaturesToProto(features, &proto);
+  EXPECT_THAT(std::string(FeaturesFromProto(proto).status().message()),
+              ::testing::HasSubstr("keypoint 1 has a non-finite or negative value"));
+  features.keypoints[1].scale = 1;
+  features.keypoints[0].view.y = std::numeric_limits<float>::infinity();
+  FeaturesToProto(features, &proto);
+  EXPECT_THAT(std::string(FeaturesFromProto(proto).status().message()),
+              ::testing::HasSubstr("keypoint 0 has"));
+}
+
+TEST(ConvertTest, MeshArraysNearTheFloatLimitOrBeyondTheLimitsAreRefused) {
+  // Finite coordinates whose area overflows float: ValidateMesh's job, on
+  // arrays as on files.
+  v1::MeshInput input;
+  for (float v : {0.f, 0.f, 0.f, 3.4e38f, 0.f, 0.f, 0.f, 3.4e38f, 0.f}) {
+    input.mutable_mesh()->add_vertices(v);
+  }
+  for (uint32_t i : {0u, 1u, 2u}) input.mutable_mesh()->add_triangles(i);
+  const absl::Status big = MeshFromProto(input).status();
+  EXPECT_EQ(big.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(big.message()), ::testing::HasSubstr("overflows float"));
+  // More vertices than a mesh file may hold (MeshReadOptions::max_vertices).
+  input.mutable_mesh()->mutable_vertices()->Resize(3 * ((1 << 25) + 1), 0.0f);
+  const absl::Status many = MeshFromProto(input).status();
+  EXPECT_EQ(many.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(std::string(many.message()), ::testing::HasSubstr("(max_vertices)"));
 }
 
 TEST(ConvertTest, HistogramsAreSparseAndExact) {

@@ -101,13 +101,16 @@ void Orthonormalise(Matrix* a) {
     for (std::size_t i = 0; i < rows; ++i) sum += x[i] * y[i];
     return sum;
   };
+  // Columns by pointer arithmetic on data(): with no rows (a sample without
+  // features) c is empty, and &c[0] would bind a reference to null (UBSan).
+  auto column = [&c, rows](std::size_t j) { return c.data() + j * rows; };
   std::vector<double> original(cols);
-  for (std::size_t j = 0; j < cols; ++j) original[j] = dot(&c[j * rows], &c[j * rows]);
+  for (std::size_t j = 0; j < cols; ++j) original[j] = dot(column(j), column(j));
   for (int pass = 0; pass < 2; ++pass) {
     for (std::size_t j = 0; j < cols; ++j) {
-      double* cj = &c[j * rows];
+      double* cj = column(j);
       for (std::size_t p = 0; p < j; ++p) {
-        const double* cp = &c[p * rows];
+        const double* cp = column(p);
         const double r = dot(cp, cj);
         for (std::size_t i = 0; i < rows; ++i) cj[i] -= r * cp[i];
       }

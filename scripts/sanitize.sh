@@ -1,0 +1,124 @@
+#!/usr/bin/env bash
+# CI's sanitizer steps, each in its own build folder:
+#   asan  the whole project and every test under AddressSanitizer and
+#         UndefinedBehaviorSanitizer (gcc; build-asan), the whole ctest suite;
+#   tsan  what the services tests need under ThreadSanitizer (gcc;
+#         build-tsan), and the services and end-to-end tests (the CLI's
+#         ingest stream and the servers are the multi-threaded code);
+#   fuzz  the libFuzzer harnesses (clang; build-fuzz), each for a short run
+#         over its seed corpus (FUZZ_SECONDS, default 20).
+#
+#   scripts/sanitize.sh            # all three, in this order
+#   scripts/sanitize.sh tsan fuzz  # some of them
+#
+# The services tests start the servers as child processes whose output goes
+# to log files, and kill them with SIGKILL; a sanitizer report there would not
+# fail a test. Every process therefore writes its reports to
+# <build>/sanitizer-reports/ (log_path), and a step fails when any report is
+# there. Suppressions (scripts/sanitizers/) are for third-party code only.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$PWD}
+JOBS=${JOBS:-$(nproc)}
+STEPS=${*:-asan tsan fuzz}
+SUPP=$PWD/scripts/sanitizers
+
+summary=()
+step_start=0
+begin() {
+  step_start=$(date +%s)
+  echo "=== sanitize: $1"
+}
+end() {
+  summary+=("$(printf '%-5s %4d s  %s' "$1" $(($(date +%s) - step_start)) "$2")")
+}
+
+# Configures $1 (once) with compiler $2, compile flags $3 and link flags $4.
+configure() {
+  local dir=$1 cxx=$2 flags=$3 link=$4
+  if [ ! -f "$dir/build.ninja" ]; then
+    cmake -S . -B "$dir" -G Ninja -DCMAKE_CXX_COMPILER="$cxx" \
+      -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" \
+      -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="$link" \
+      -DMESHSEEK_BUILD_BENCHMARKS=OFF
+  fi
+}
+
+# Fails when any process of the run left a sanitizer report in $1: a
+# log_path file of ASan/LSan/TSan, or a report in a server's log under
+# $1/tmp (gcc's UBSan ignores log_path and writes to stderr, which the
+# services tests send to <TEST_TMPDIR>/<role>-<port>.log).
+check_reports() {
+  local reports
+  reports=$( (find "$1" -maxdepth 1 -type f
+              grep -rlE 'runtime error:|ERROR: (Address|Leak)Sanitizer|WARNING: ThreadSanitizer' \
+                "$1/tmp" 2>/dev/null) | sort -u)
+  if [ -n "$reports" ]; then
+    for r in $reports; do
+      echo "--- $r"
+      grep -m1 -A60 -E 'runtime error:|Sanitizer' "$r" || head -60 "$r"
+    done
+    echo "sanitize: $(echo "$reports" | wc -l) file(s) with sanitizer reports in $1" >&2
+    return 1
+  fi
+}
+
+for step in $STEPS; do
+  case $step in
+    asan)
+      begin "ASan + UBSan: whole project, whole test suite (build-asan)"
+      flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+      configure build-asan g++ "$flags" "$flags"
+      cmake --build build-asan -- -j"$JOBS"
+      reports=$PWD/build-asan/sanitizer-reports
+      rm -rf "$reports" && mkdir -p "$reports/tmp"
+      TEST_TMPDIR=$reports/tmp \
+      ASAN_OPTIONS="log_path=$reports/asan:detect_leaks=1:strict_string_checks=1:check_initialization_order=1" \
+      LSAN_OPTIONS="suppressions=$SUPP/lsan.supp:print_suppressions=0" \
+      UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+        ctest --test-dir build-asan --output-on-failure -j"$JOBS" || rc=$?
+      check_reports "$reports" || rc=1
+      [ "${rc:-0}" -eq 0 ] || exit "$rc"
+      end asan "ctest, every test"
+      ;;
+    tsan)
+      begin "TSan: services and end-to-end tests (build-tsan)"
+      # Every TSan executable links the absl::Mutex annotations first, so that
+      # its Mutex entry points win over Debian's uninstrumented ones
+      # (scripts/sanitizers/absl_mutex_tsan.cc says why).
+      mkdir -p build-tsan
+      shim=$PWD/build-tsan/libabsl_mutex_tsan.so
+      if [ ! -f "$shim" ] || [ "$SUPP/absl_mutex_tsan.cc" -nt "$shim" ]; then
+        g++ -std=c++17 -shared -fPIC -O1 -fsanitize=thread -o "$shim" "$SUPP/absl_mutex_tsan.cc" -ldl
+      fi
+      configure build-tsan g++ "-fsanitize=thread -fno-omit-frame-pointer" \
+        "-fsanitize=thread -Wl,--no-as-needed $shim -Wl,--as-needed"
+      cmake --build build-tsan --target tests_services_test tests_end_to_end_test meshseek-probe \
+        -- -j"$JOBS"
+      reports=$PWD/build-tsan/sanitizer-reports
+      rm -rf "$reports" && mkdir -p "$reports/tmp"
+      TEST_TMPDIR=$reports/tmp \
+      TSAN_OPTIONS="log_path=$reports/tsan:suppressions=$SUPP/tsan.supp:halt_on_error=0:second_deadlock_stack=1" \
+        ctest --test-dir build-tsan --output-on-failure -R '^tests/' -j"$JOBS" || rc=$?
+      check_reports "$reports" || rc=1
+      [ "${rc:-0}" -eq 0 ] || exit "$rc"
+      end tsan "ctest -R ^tests/ (services, end to end)"
+      ;;
+    fuzz)
+      begin "libFuzzer: every harness for ${FUZZ_SECONDS:-20} s (build-fuzz)"
+      if [ ! -f build-fuzz/build.ninja ]; then
+        cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DMESHSEEK_FUZZ=ON \
+          -DMESHSEEK_BUILD_TESTS=OFF -DMESHSEEK_BUILD_BENCHMARKS=OFF \
+          -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only"
+      fi
+      cmake --build build-fuzz --target fuzzers -- -j"$JOBS"
+      tests/fuzz/run.sh build-fuzz -max_total_time="${FUZZ_SECONDS:-20}"
+      end fuzz "each harness ${FUZZ_SECONDS:-20} s"
+      ;;
+    *)
+      echo "sanitize: unknown step '$step' (asan, tsan or fuzz)" >&2
+      exit 2
+      ;;
+  esac
+done
+printf 'sanitize: %s\n' "${summary[@]}"

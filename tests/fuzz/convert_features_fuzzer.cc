@@ -1,0 +1,20 @@
+// FeaturesFromProto on a LocalFeatures message parsed from the bytes (what the
+// codebook service receives); accepted features are consistent and round-trip.
+#include <cstdint>
+#include <cstdlib>
+
+#include "common/rpc/convert.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  meshseek::v1::LocalFeatures message;
+  if (!message.ParseFromArray(data, static_cast<int>(size))) return 0;
+  const absl::StatusOr<meshseek::LocalFeatures> features =
+      meshseek::rpc::FeaturesFromProto(message);
+  if (!features.ok()) return 0;
+  if (features->descriptors.size() != features->size() * meshseek::kSiftDimension) std::abort();
+  meshseek::v1::LocalFeatures back;
+  meshseek::rpc::FeaturesToProto(*features, &back);
+  const absl::StatusOr<meshseek::LocalFeatures> again = meshseek::rpc::FeaturesFromProto(back);
+  if (!again.ok() || again->size() != features->size()) std::abort();
+  return 0;
+}

@@ -1,0 +1,1 @@
+jsideways²magic

@@ -1,0 +1,1 @@
+8Ð@juprstretchˆô²exact
