@@ -56,7 +56,6 @@ absl::StatusOr<TriangleMesh> MeshFromProto(const v1::MeshInput& input,
       }
       // The same limits as a mesh sent as a file: arrays are already in
       // memory, but every later stage allocates a multiple of their size.
-      const MeshReadOptions limits;
       if (static_cast<uint64_t>(m.vertices_size() / 3) > limits.max_vertices ||
           static_cast<uint64_t>(m.triangles_size() / 3) > limits.max_triangles) {
         return absl::ResourceExhaustedError(absl::StrCat(
