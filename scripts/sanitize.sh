@@ -31,6 +31,7 @@ begin() {
 }
 end() {
   summary+=("$(printf '%-5s %4d s  %s' "$1" $(($(date +%s) - step_start)) "$2")")
+  echo "=== sanitize: ${summary[-1]}"
 }
 
 # Configures $1 (once) with compiler $2, compile flags $3 and link flags $4.
@@ -89,7 +90,8 @@ for step in $STEPS; do
       mkdir -p build-tsan
       shim=$PWD/build-tsan/libabsl_mutex_tsan.so
       if [ ! -f "$shim" ] || [ "$SUPP/absl_mutex_tsan.cc" -nt "$shim" ]; then
-        g++ -std=c++17 -shared -fPIC -O1 -fsanitize=thread -o "$shim" "$SUPP/absl_mutex_tsan.cc" -ldl
+        g++ -std=c++17 -shared -fPIC -O1 -fsanitize=thread -o "$shim" "$SUPP/absl_mutex_tsan.cc" \
+          -labsl_synchronization -ldl
       fi
       configure build-tsan g++ "-fsanitize=thread -fno-omit-frame-pointer" \
         "-fsanitize=thread -Wl,--no-as-needed $shim -Wl,--as-needed"
