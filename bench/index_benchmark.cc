@@ -37,6 +37,7 @@
 #include "absl/strings/str_split.h"
 #include "bench/synthetic_histograms.h"
 #include "common/rpc/client.h"
+#include "common/rpc/free_port.h"
 #include "common/rpc/convert.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "meshseek/v1/index.grpc.pb.h"
@@ -62,17 +63,6 @@ double Seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
 }
 
-int FreePort() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-  socklen_t len = sizeof addr;
-  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-  close(fd);
-  return ntohs(addr.sin_port);
-}
 
 // The index server as a child process.
 class IndexProcess {
@@ -154,7 +144,7 @@ void RunSize(std::size_t n) {
   const std::string dir = absl::StrCat(absl::GetFlag(FLAGS_data_dir), "/n", n);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
-  IndexProcess server(dir, FreePort());
+  IndexProcess server(dir, rpc::FreeLoopbackPort());
   if (!server.Start()) {
     std::fprintf(stderr, "index server did not start (see %s.log)\n", dir.c_str());
     std::exit(1);

@@ -23,6 +23,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "common/rpc/client.h"
+#include "common/rpc/free_port.h"
 #include "gmock/gmock.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "gtest/gtest.h"
@@ -133,17 +134,6 @@ std::vector<MeshCase> ValidFiles() {
   };
 }
 
-int FreePort() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-  socklen_t len = sizeof addr;
-  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-  close(fd);
-  return ntohs(addr.sin_port);
-}
 
 // Resident memory of a process, in MiB (VmRSS).
 double ResidentMiB(pid_t pid) {
@@ -183,7 +173,7 @@ class HostileInputTest : public ::testing::Test {
     dir_ = ::testing::TempDir() + "/meshseek_hostile";
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_ + "/files");
-    port_ = FreePort();
+    port_ = rpc::FreeLoopbackPort();
     pid_ = fork();
     if (pid_ == 0) {
       const int fd = ::open((dir_ + "/serve.log").c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);

@@ -25,6 +25,7 @@
 #include "common/geometry/mesh_io.h"
 #include "common/pipeline/retrieval_pipeline.h"
 #include "common/rpc/client.h"
+#include "common/rpc/free_port.h"
 #include "common/rpc/convert.h"
 #include "common/rpc/status.h"
 #include "common/synth/synthetic_benchmark.h"
@@ -63,17 +64,6 @@ double CpuSeconds(pid_t pid) {
   return ticks / static_cast<double>(sysconf(_SC_CLK_TCK));
 }
 
-int FreePort() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-  socklen_t len = sizeof addr;
-  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-  close(fd);
-  return ntohs(addr.sin_port);
-}
 
 std::string Address(int port) { return absl::StrCat("127.0.0.1:", port); }
 
@@ -157,20 +147,20 @@ class Stack {
   Stack(const std::string& dir, int extract_workers, int max_pending = 512, int index_shards = 1,
         const std::vector<std::string>& coordinator_flags = {})
       : dir_(dir) {
-    resample_ = std::make_unique<Server>("resample", std::vector<std::string>{}, FreePort());
+    resample_ = std::make_unique<Server>("resample", std::vector<std::string>{}, rpc::FreeLoopbackPort());
     std::string targets;
     for (int w = 0; w < extract_workers; ++w) {
       extract_.push_back(std::make_unique<Server>(
-          "extract", std::vector<std::string>{"--workers=1"}, FreePort()));
+          "extract", std::vector<std::string>{"--workers=1"}, rpc::FreeLoopbackPort()));
       absl::StrAppend(&targets, targets.empty() ? "" : ",", Address(extract_.back()->port()));
     }
     codebook_ = std::make_unique<Server>(
-        "codebook", std::vector<std::string>{"--data_dir=" + dir + "/codebook"}, FreePort());
+        "codebook", std::vector<std::string>{"--data_dir=" + dir + "/codebook"}, rpc::FreeLoopbackPort());
     std::string shards;
     for (int s = 0; s < index_shards; ++s) {
       index_.push_back(std::make_unique<Server>(
           "index", std::vector<std::string>{absl::StrCat("--data_dir=", dir, "/index", s)},
-          FreePort()));
+          rpc::FreeLoopbackPort()));
       absl::StrAppend(&shards, shards.empty() ? "" : ",", Address(index_.back()->port()));
     }
     coordinator_args_ = {"--data_dir=" + dir + "/coordinator",
@@ -182,7 +172,7 @@ class Stack {
                          absl::StrCat("--max_pending=", max_pending)};
     coordinator_args_.insert(coordinator_args_.end(), coordinator_flags.begin(),
                              coordinator_flags.end());
-    coordinator_ = std::make_unique<Server>("coordinator", coordinator_args_, FreePort());
+    coordinator_ = std::make_unique<Server>("coordinator", coordinator_args_, rpc::FreeLoopbackPort());
   }
   bool WaitServing() {
     for (Server* s : {resample_.get(), codebook_.get(), coordinator_.get()}) {
@@ -560,7 +550,7 @@ TEST_F(ServicesTest, BadInputGetsTheRightCodeANamedProblemAndServersKeepServing)
 TEST(ServicesLoadTest, SixtyFourConcurrentAddModelCallsToTheIndexAllSucceed) {
   const std::string dir = ::testing::TempDir() + "/meshseek_index_burst";
   std::filesystem::remove_all(dir);
-  Server index("index", {"--data_dir=" + dir}, FreePort());
+  Server index("index", {"--data_dir=" + dir}, rpc::FreeLoopbackPort());
   ASSERT_TRUE(index.WaitServing());
   auto stub = v1::Index::NewStub(rpc::MakeChannel(Address(index.port())));
   constexpr int kCalls = 64;
@@ -656,7 +646,7 @@ TEST_F(ServicesTest, TwoIndexShardsGiveTheResultsOfOneAndNeverAPartialAnswer) {
                {"--data_dir=" + *dir_ + "/shards/coordinator", "--resample=127.0.0.1:1",
                 "--extract=127.0.0.1:1", "--codebook=127.0.0.1:1",
                 "--index=" + Address(stack.index(0).port())},
-               FreePort());
+               rpc::FreeLoopbackPort());
   EXPECT_GT(other.WaitExit(absl::Seconds(20)), 0);
 }
 
