@@ -83,7 +83,7 @@ absl::Status BuildRunner::ResumeInterrupted() {
 
 absl::Status BuildRunner::Train(const std::string& codebook_id,
                                 const CollectionInfo& info,
-                                const std::vector<ExtractedModel>& members) {
+                                const std::vector<v1::LocalFeatures>& features) {
   v1::Codebook::Stub* codebook = workers_->codebook();
   return rpc::RetryTransient(
       [&]() -> absl::Status {
@@ -111,13 +111,8 @@ absl::Status BuildRunner::Train(const std::string& codebook_id,
         chunk.set_seed(info.options.kmeans.seed);
         chunk.set_dimension(kSiftDimension);
         bool open = true;
-        v1::LocalFeatures features;
-        for (const ExtractedModel& m : members) {
-          if (!features.ParseFromString(m.features)) {
-            return absl::DataLossError(
-                absl::StrCat("model ", m.model_id, ": stored features do not parse"));
-          }
-          chunk.mutable_descriptors()->append(features.descriptors());
+        for (const v1::LocalFeatures& f : features) {
+          chunk.mutable_descriptors()->append(f.descriptors());
           if (chunk.descriptors().size() >= kTrainChunkBytes) {
             open = open && writer->Write(chunk);
             chunk.clear_descriptors();
@@ -142,8 +137,18 @@ void BuildRunner::Run(const std::string& job_id, const std::string& collection) 
   const absl::Time start = absl::Now();
   absl::StatusOr<std::vector<ExtractedModel>> members = store_->ExtractedModels(collection);
   if (!members.ok()) return fail(members.status());
+  // Parsed once, for training and encoding; the stored bytes are let go.
+  std::vector<v1::LocalFeatures> features(members->size());
+  for (std::size_t i = 0; i < members->size(); ++i) {
+    ExtractedModel& m = (*members)[i];
+    if (!features[i].ParseFromString(m.features)) {
+      return fail(absl::DataLossError(
+          absl::StrCat("model ", m.model_id, ": stored features do not parse")));
+    }
+    std::string().swap(m.features);
+  }
   // 1. The codebook, unless a resumed build trained it already.
-  if (absl::Status trained = Train(codebook_id, *info, *members); !trained.ok()) {
+  if (absl::Status trained = Train(codebook_id, *info, features); !trained.ok()) {
     if (*stop_) return Done(collection);  // resumed after the restart
     return fail(Prefixed(trained, "codebook training: "));
   }
@@ -153,12 +158,7 @@ void BuildRunner::Run(const std::string& job_id, const std::string& collection) 
   ParallelFor(members->size(), options_.max_in_flight, [&](std::size_t i) {
     const ExtractedModel& m = (*members)[i];
     if (m.indexed_codebook == codebook_id || *stop_) return;
-    v1::LocalFeatures features;
-    if (!features.ParseFromString(m.features)) {
-      errors[i] = absl::DataLossError("stored features do not parse");
-      return;
-    }
-    absl::StatusOr<v1::SparseHistogram> histogram = workers_->Encode(codebook_id, features);
+    absl::StatusOr<v1::SparseHistogram> histogram = workers_->Encode(codebook_id, features[i]);
     errors[i] = histogram.ok()
                     ? workers_->AddToIndex(collection, m.model_id, m.ordinal, m.label, *histogram)
                     : histogram.status();

@@ -45,7 +45,7 @@ class BuildRunner {
   void Run(const std::string& job_id, const std::string& collection);
   absl::Status Train(const std::string& codebook_id,
                      const CollectionInfo& info,
-                     const std::vector<ExtractedModel>& members);
+                     const std::vector<v1::LocalFeatures>& features);
   // `collection` is no longer building.
   void Done(const std::string& collection);
 
