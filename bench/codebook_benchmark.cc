@@ -338,7 +338,7 @@ int Encode() {
   const double cpu = CpuSeconds();
   std::vector<std::vector<float>> histograms(num_models);
   ParallelFor(num_models, threads, [&](std::size_t i) {
-    histograms[i] = *codebook->Encode(models[i].data(), models[i].size() / kDim);
+    histograms[i] = *codebook->Encode(models[i].data(), models[i].size() / kDim, kDim);
   });
   const double seconds = Now() - t, cpu_seconds = CpuSeconds() - cpu;
   std::printf(
@@ -366,7 +366,7 @@ int Encode() {
   for (std::size_t i = 0; i < num_exact; ++i) {
     const std::vector<uint32_t> labels =
         *codebook->NearestCentroids(models[i].data(), models[i].size() / kDim);
-    const std::vector<float> h = *exact->Encode(models[i].data(), models[i].size() / kDim);
+    const std::vector<float> h = *exact->Encode(models[i].data(), models[i].size() / kDim, kDim);
     for (std::size_t j = 0; j < labels.size(); ++j) same += labels[j] == exact_labels[i][j];
     count += labels.size();
     for (std::size_t w = 0; w < h.size(); ++w) l1 += std::abs(h[w] - histograms[i][w]);

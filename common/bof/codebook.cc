@@ -130,10 +130,16 @@ absl::StatusOr<std::vector<uint32_t>> Codebook::NearestCentroids(const uint8_t* 
 }
 
 absl::StatusOr<std::vector<float>> Codebook::Encode(const uint8_t* descriptors,
-                                                    std::size_t count) const {
+                                                    std::size_t count,
+                                                    std::size_t dimension) const {
   if (count == 0) {
     return absl::InvalidArgumentError(
         "codebook: cannot encode an empty descriptor set (0 descriptors)");
+  }
+  if (dimension != dim_) {
+    return absl::InvalidArgumentError(absl::StrCat("codebook: descriptors of dimension ", dimension,
+                                                   ", the codebook's words have ",
+                                                   dim_));
   }
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<uint32_t> labels,
                             NearestCentroids(descriptors, count));

@@ -91,8 +91,11 @@ class Codebook {
   /// of the `count` descriptors whose nearest word it is. Length size(), sums
   /// to 1 (up to float rounding). InvalidArgument when count is 0: a model
   /// without descriptors has no histogram, and a uniform or zero one would
-  /// silently rank it among the others.
-  absl::StatusOr<std::vector<float>> Encode(const uint8_t* descriptors, std::size_t count) const;
+  /// silently rank it among the others, and when `dimension` is not the
+  /// codebook's (features of another method).
+  absl::StatusOr<std::vector<float>> Encode(const uint8_t* descriptors,
+                                            std::size_t count,
+                                            std::size_t dimension) const;
 
   /// The serialised form described above.
   std::string Serialize() const;

@@ -65,7 +65,7 @@ TEST(CodebookTest, EncodeIsTheNormalisedHistogramOfNearestWords) {
   const Codebook codebook = RandomCodebook(50, kDim, 3);
   const std::size_t count = 777;
   const std::vector<uint8_t> descriptors = RandomDescriptors(count, kDim, 4);
-  const absl::StatusOr<std::vector<float>> histogram = codebook.Encode(descriptors.data(), count);
+  const absl::StatusOr<std::vector<float>> histogram = codebook.Encode(descriptors.data(), count, kDim);
   ASSERT_TRUE(histogram.ok()) << histogram.status();
   ASSERT_EQ(histogram->size(), 50u);
   std::vector<double> expected(50, 0.0);
@@ -83,7 +83,7 @@ TEST(CodebookTest, EncodeIsTheNormalisedHistogramOfNearestWords) {
 TEST(CodebookTest, EmptyDescriptorSetIsAnError) {
   const Codebook codebook = RandomCodebook(4, 8, 5);
   const uint8_t unused[8] = {};
-  const absl::StatusOr<std::vector<float>> histogram = codebook.Encode(unused, 0);
+  const absl::StatusOr<std::vector<float>> histogram = codebook.Encode(unused, 0, kDim);
   EXPECT_EQ(histogram.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(histogram.status().message()), HasSubstr("empty descriptor set"));
   EXPECT_THAT(std::string(codebook.NearestCentroids(nullptr, 3).status().message()),
@@ -103,7 +103,7 @@ TEST(CodebookTest, TrainLearnsTheRequestedVocabulary) {
   EXPECT_EQ(codebook->dim(), kDim);
   EXPECT_EQ(report.training_points, 2000u);
   // Every word is used: k-means leaves no cluster empty on such data.
-  const std::vector<float> histogram = codebook->Encode(descriptors.data(), 2000).value();
+  const std::vector<float> histogram = codebook->Encode(descriptors.data(), 2000, kDim).value();
   for (float h : histogram) EXPECT_GT(h, 0.0f);
 
   options.num_centroids = 3000;

@@ -1,6 +1,9 @@
-// The output of every local-feature extractor: keypoints and their SIFT
+// The output of every local-feature extractor: keypoints and their
 // descriptors, one keypoint per descriptor (a point seen from two sides gives
 // two keypoints with the same position and opposite view directions).
+// Descriptors are bytes of one dimension per method: 128 for the SIFT
+// methods, the method's own for the others (LSF); the codebook learns and
+// encodes any dimension.
 #ifndef MESHSEEK_COMMON_FEATURES_LOCAL_FEATURES_H_
 #define MESHSEEK_COMMON_FEATURES_LOCAL_FEATURES_H_
 
@@ -20,12 +23,18 @@ struct Keypoint {
   int level;    // scale-space level of a detected point; 0 for dense points
 };
 
+/// Bound on a descriptor's dimension: what a peer may declare before its
+/// bytes are trusted.
+inline constexpr std::size_t kMaxDescriptorDimension = 1024;
+
 struct LocalFeatures {
   std::vector<Keypoint> keypoints;
-  std::vector<uint8_t> descriptors;  // keypoints.size() x kSiftDimension, row-major
+  /// Bytes per descriptor (1 to kMaxDescriptorDimension).
+  std::size_t dimension = kSiftDimension;
+  std::vector<uint8_t> descriptors;  // keypoints.size() x dimension, row-major
 
   std::size_t size() const { return keypoints.size(); }
-  const uint8_t* descriptor(std::size_t i) const { return descriptors.data() + i * kSiftDimension; }
+  const uint8_t* descriptor(std::size_t i) const { return descriptors.data() + i * dimension; }
 };
 
 }  // namespace meshseek

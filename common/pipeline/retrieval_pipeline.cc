@@ -110,15 +110,24 @@ absl::StatusOr<std::vector<LocalFeatures>> ExtractCollection(
 absl::StatusOr<Codebook> TrainCollectionCodebook(const std::vector<LocalFeatures>& features,
                                                  const RetrievalPipelineOptions& options) {
   std::size_t total = 0;
-  for (const LocalFeatures& f : features) total += f.size();
+  std::size_t dimension = 0;
+  for (const LocalFeatures& f : features) {
+    if (f.size() == 0) continue;
+    if (dimension != 0 && f.dimension != dimension) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "codebook: local features of dimensions ", dimension, " and ", f.dimension, " mixed"));
+    }
+    dimension = f.dimension;
+    total += f.size();
+  }
   std::vector<uint8_t> descriptors;
-  descriptors.reserve(total * kSiftDimension);
+  descriptors.reserve(total * dimension);
   for (const LocalFeatures& f : features) {
     descriptors.insert(descriptors.end(), f.descriptors.begin(), f.descriptors.end());
   }
   KMeansOptions kmeans = options.kmeans;
   kmeans.num_threads = options.num_threads;
-  return Codebook::Train(descriptors.data(), total, kSiftDimension, kmeans);
+  return Codebook::Train(descriptors.data(), total, dimension, kmeans);
 }
 
 absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
@@ -129,7 +138,8 @@ absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
   std::vector<absl::Status> errors(features.size());
   ParallelFor(features.size(), options.num_threads, [&](std::size_t i) {
     if (features[i].size() == 0) return;  // no histogram: see RankCollection
-    auto histogram = codebook.Encode(features[i].descriptors.data(), features[i].size());
+    auto histogram = codebook.Encode(features[i].descriptors.data(), features[i].size(),
+                                     features[i].dimension);
     if (histogram.ok()) {
       histograms[i] = *std::move(histogram);
     } else {

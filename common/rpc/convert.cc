@@ -98,14 +98,16 @@ void MeshToProto(const TriangleMesh& mesh, v1::Mesh* out) {
 
 absl::StatusOr<LocalFeatures> FeaturesFromProto(const v1::LocalFeatures& f) {
   const std::size_t n = f.count();
-  if (f.dimension() != kSiftDimension && n > 0) {
-    return absl::InvalidArgumentError(absl::StrCat("local features: descriptor dimension ",
-                                                   f.dimension(), ", expected ", kSiftDimension));
+  // An empty set may leave the dimension unset.
+  const std::size_t dim = n == 0 && f.dimension() == 0 ? kSiftDimension : f.dimension();
+  if (dim == 0 || dim > kMaxDescriptorDimension) {
+    return absl::InvalidArgumentError(absl::StrCat("local features: descriptor dimension ", dim,
+                                                   ", expected 1 to ", kMaxDescriptorDimension));
   }
-  if (f.descriptors().size() != n * kSiftDimension) {
+  if (f.descriptors().size() != n * dim) {
     return absl::InvalidArgumentError(
         absl::StrCat("local features: ", f.descriptors().size(), " descriptor bytes for ", n,
-                     " features of ", kSiftDimension, " (need ", n * kSiftDimension, ")"));
+                     " features of ", dim, " (need ", n * dim, ")"));
   }
   const bool has_keypoints = f.positions_size() > 0;
   if (has_keypoints &&
@@ -118,6 +120,7 @@ absl::StatusOr<LocalFeatures> FeaturesFromProto(const v1::LocalFeatures& f) {
         absl::StrCat("local features: keypoint arrays do not match the count ", n));
   }
   LocalFeatures features;
+  features.dimension = dim;
   features.descriptors.assign(f.descriptors().begin(), f.descriptors().end());
   features.keypoints.resize(n);
   if (has_keypoints) {
@@ -145,7 +148,7 @@ absl::StatusOr<LocalFeatures> FeaturesFromProto(const v1::LocalFeatures& f) {
 void FeaturesToProto(const LocalFeatures& features, v1::LocalFeatures* out) {
   out->Clear();
   out->set_count(static_cast<uint32_t>(features.size()));
-  out->set_dimension(kSiftDimension);
+  out->set_dimension(static_cast<uint32_t>(features.dimension));
   out->set_descriptors(features.descriptors.data(), features.descriptors.size());
   for (const Keypoint& k : features.keypoints) {
     for (const Vec3f* v : {&k.position, &k.view, &k.up}) {

@@ -71,10 +71,10 @@ grpc::Status CodebookService::Train(grpc::ServerContext*,
     return grpc::Status::OK;
   }
   const std::size_t dim = first.dimension();
-  if (dim != kSiftDimension) {
+  if (dim == 0 || dim > kMaxDescriptorDimension) {
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                        absl::StrCat("train ", id, ": descriptor dimension ", dim, ", expected ",
-                                     kSiftDimension));
+                        absl::StrCat("train ", id, ": descriptor dimension ", dim,
+                                     ", expected 1 to ", kMaxDescriptorDimension));
   }
   std::string descriptors = first.descriptors();
   v1::TrainCodebookRequest chunk;
@@ -143,7 +143,8 @@ grpc::Status CodebookService::Encode(grpc::ServerContext*,
   std::vector<float> histogram;  // empty: a model without features
   if (features->size() > 0) {
     absl::StatusOr<std::vector<float>> encoded =
-        entry->codebook->Encode(features->descriptors.data(), features->size());
+        entry->codebook->Encode(features->descriptors.data(), features->size(),
+                                features->dimension);
     if (!encoded.ok()) return rpc::ToGrpcStatus(encoded.status());
     histogram = *std::move(encoded);
   }

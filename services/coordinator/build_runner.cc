@@ -109,9 +109,20 @@ absl::Status BuildRunner::Train(const std::string& codebook_id,
         chunk.set_kmeans_iterations(info.options.kmeans.max_iterations);
         chunk.set_kmeans_assignment(KMeansAssignmentName(info.options.kmeans.assignment));
         chunk.set_seed(info.options.kmeans.seed);
-        chunk.set_dimension(kSiftDimension);
+        // One dimension per method; the codebook service checks every chunk.
+        for (const v1::LocalFeatures& f : features) {
+          if (f.count() > 0) {
+            chunk.set_dimension(f.dimension());
+            break;
+          }
+        }
         bool open = true;
         for (const v1::LocalFeatures& f : features) {
+          if (f.count() > 0 && f.dimension() != chunk.dimension()) {
+            return absl::DataLossError(absl::StrCat("stored features of dimensions ",
+                                                    chunk.dimension(), " and ", f.dimension(),
+                                                    " in one collection"));
+          }
           chunk.mutable_descriptors()->append(f.descriptors());
           if (chunk.descriptors().size() >= kTrainChunkBytes) {
             open = open && writer->Write(chunk);

@@ -11,7 +11,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const absl::StatusOr<meshseek::LocalFeatures> features =
       meshseek::rpc::FeaturesFromProto(message);
   if (!features.ok()) return 0;
-  if (features->descriptors.size() != features->size() * meshseek::kSiftDimension) std::abort();
+  if (features->descriptors.size() != features->size() * features->dimension) std::abort();
   meshseek::v1::LocalFeatures back;
   meshseek::rpc::FeaturesToProto(*features, &back);
   const absl::StatusOr<meshseek::LocalFeatures> again = meshseek::rpc::FeaturesFromProto(back);
