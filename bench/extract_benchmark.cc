@@ -145,7 +145,7 @@ BENCHMARK(BM_ExtractRldSamples)
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  absl::ParseCommandLine(argc, argv);
+  meshseek::cli::ParseCommandLineWithParams(argc, argv, "");
   auto options = meshseek::cli::PipelineOptionsFromFlags();
   if (!options.ok()) {
     std::cerr << options.status() << "\n";

@@ -159,7 +159,7 @@ absl::Status CreateCollection(v1::Coordinator::Stub* stub, const std::string& na
   rpc::SetDeadline(&context, absl::Minutes(1));
   v1::CreateCollectionRequest request;
   request.set_name(name);
-  *request.mutable_params() = cli::PipelineParamsFromFlags();
+  MESHSEEK_ASSIGN_OR_RETURN(*request.mutable_params(), cli::PipelineParamsFromFlags());
   v1::Collection response;
   return rpc::FromGrpcStatus(stub->CreateCollection(&context, request, &response));
 }
@@ -283,8 +283,8 @@ absl::Status Run() {
 }  // namespace meshseek
 
 int main(int argc, char** argv) {
-  absl::SetProgramUsageMessage("load generator: N concurrent Query and Ingest clients on the embedded stack");
-  absl::ParseCommandLine(argc, argv);
+  meshseek::cli::ParseCommandLineWithParams(
+      argc, argv, "load generator: N concurrent Query and Ingest clients on the embedded stack");
   cv::setNumThreads(0);  // meshseek parallelises across calls itself, as the CLI does
   const absl::Status status = meshseek::Run();
   if (!status.ok()) {

@@ -220,7 +220,7 @@ int Run() {
 }  // namespace meshseek
 
 int main(int argc, char** argv) {
-  absl::ParseCommandLine(argc, argv);
+  meshseek::cli::ParseCommandLineWithParams(argc, argv, "");
   cv::setNumThreads(0);
   return meshseek::Run();
 }

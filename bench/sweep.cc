@@ -55,7 +55,7 @@ std::vector<T> ParseList(const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  absl::ParseCommandLine(argc, argv);
+  meshseek::cli::ParseCommandLineWithParams(argc, argv, "");
   cv::setNumThreads(0);
   using namespace meshseek;
   auto models = ReadManifest(absl::GetFlag(FLAGS_manifest));

@@ -276,7 +276,7 @@ absl::Status IngestModels(v1::Coordinator::Stub* stub, const std::string& collec
 absl::Status EnsureCollection(v1::Coordinator::Stub* stub, const std::string& name) {
   v1::CreateCollectionRequest create;
   create.set_name(name);
-  *create.mutable_params() = PipelineParamsFromFlags();
+  MESHSEEK_ASSIGN_OR_RETURN(*create.mutable_params(), PipelineParamsFromFlags());
   v1::Collection collection;
   return Call(stub, &v1::Coordinator::Stub::CreateCollection, create, &collection);
 }
@@ -407,27 +407,17 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
   if (collection.empty()) {
     // Named after the manifest's folder, the method and a hash of the
     // parameters, so that evaluating again reuses the extracted models.
-    const std::string params = PipelineParamsFromFlags().SerializeAsString();
+    // The canonical parameters (every one of the method, by name).
+    v1::PipelineParams canonical;
+    rpc::PipelineParamsToProto(options, &canonical);
+    const std::string params = canonical.SerializeAsString();
     std::string folder = std::filesystem::absolute(manifest_path).parent_path().filename().string();
     for (char& c : folder) {
       if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
     }
-    auto name = [&](uint64_t offset_basis) {
-      return absl::StrCat(folder.empty() ? "eval" : folder, "-",
-                          FeatureMethodName(options.extractor.method), "-",
-                          absl::Hex(Fnv1a64(params, offset_basis) & 0xffffffffu, absl::kZeroPad8));
-    };
-    collection = name(kFnv1a64OffsetBasis);
-    // A data folder of an earlier release names it with the mistaken basis:
-    // keep using that collection rather than extracting everything again.
-    const std::string legacy = name(kLegacyFnv1a64OffsetBasis);
-    v1::GetCollectionRequest get;
-    v1::Collection found;
-    get.set_name(collection);
-    if (!Call(stub, &v1::Coordinator::Stub::GetCollection, get, &found).ok()) {
-      get.set_name(legacy);
-      if (Call(stub, &v1::Coordinator::Stub::GetCollection, get, &found).ok()) collection = legacy;
-    }
+    collection = absl::StrCat(
+        folder.empty() ? "eval" : folder, "-", FeatureMethodName(options.extractor.method), "-",
+        absl::Hex(Fnv1a64(params, kFnv1a64OffsetBasis) & 0xffffffffu, absl::kZeroPad8));
   }
   MESHSEEK_RETURN_IF_ERROR(EnsureCollection(stub, collection));
   std::vector<ModelToIngest> to_ingest;

@@ -13,12 +13,11 @@
 #include <vector>
 
 #include "absl/flags/flag.h"
-#include "absl/flags/parse.h"
-#include "absl/flags/usage.h"
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "cli/commands.h"
+#include "cli/pipeline_flags.h"
 #include "common/base/logging.h"
 
 namespace {
@@ -65,8 +64,7 @@ int Fail(const absl::Status& status) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  absl::SetProgramUsageMessage(kUsage);
-  std::vector<char*> args = absl::ParseCommandLine(argc, argv);
+  std::vector<char*> args = meshseek::cli::ParseCommandLineWithParams(argc, argv, kUsage);
   if (args.size() < 2) {
     std::fprintf(stderr, "%s\n", kUsage);
     return 2;

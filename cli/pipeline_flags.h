@@ -1,23 +1,36 @@
 // Command-line flags for every retrieval-pipeline parameter, shared by the
-// meshseek CLI and the bench tools so that a parameter has one flag, one help
-// text and one default (the option struct's own). Flags become a
-// PipelineParams message, and options come from that message by the same
+// meshseek CLI and the bench tools. The flags are the parameter table of
+// common/pipeline/pipeline_params.h: `--name=value` or `--name value` for
+// every name there, with its type, range, per-method defaults and help
+// generated from the table, so a new parameter needs no flag of its own.
+// They become named values, and options come from those by the same
 // conversion the services use (rpc::PipelineOptionsFromParams).
 #ifndef MESHSEEK_CLI_PIPELINE_FLAGS_H_
 #define MESHSEEK_CLI_PIPELINE_FLAGS_H_
 
+#include <vector>
+
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "common/pipeline/retrieval_pipeline.h"
 #include "meshseek/v1/types.pb.h"
 
 namespace meshseek::cli {
 
-// The collection parameters from the flags: every field set (the flags'
-// defaults are the core's), for CreateCollection and for the in-process path.
-v1::PipelineParams PipelineParamsFromFlags();
+// Sets the program's usage message to `usage` and the parameter list, then
+// absl::ParseCommandLine after taking the pipeline parameters out of argv
+// (the table's names are not Abseil flags). Returns the positional
+// arguments, argv[0] first.
+std::vector<char*> ParseCommandLineWithParams(int argc, char** argv, absl::string_view usage);
 
-// Options from the flags (--method, --scale, --points, --vocabulary, ...),
-// validated: InvalidArgument names the bad flag and value.
+// The collection parameters from the flags, canonical (every parameter of
+// the method, rpc::PipelineParamsToProto), for CreateCollection; or the
+// error of PipelineOptionsFromFlags.
+absl::StatusOr<v1::PipelineParams> PipelineParamsFromFlags();
+
+// Options from the parameter flags (--method, --scale, --points, --vocabulary,
+// ...) and --threads / --progress, validated: InvalidArgument names the bad
+// parameter and value.
 absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags();
 
 }  // namespace meshseek::cli

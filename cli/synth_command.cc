@@ -5,11 +5,11 @@
 #include "absl/flags/flag.h"
 #include "absl/status/status.h"
 #include "cli/commands.h"
+#include "cli/pipeline_flags.h"
 #include "common/base/status_macros.h"
 #include "common/synth/synthetic_benchmark.h"
 
 ABSL_DECLARE_FLAG(std::string, out);
-ABSL_DECLARE_FLAG(uint64_t, seed);
 ABSL_FLAG(int,
           models_per_class,
           meshseek::SyntheticBenchmarkOptions().models_per_class,
@@ -22,8 +22,10 @@ absl::Status RunSynth() {
   if (out_dir.empty()) return absl::InvalidArgumentError("synth needs --out DIR");
   SyntheticBenchmarkOptions options;
   options.models_per_class = absl::GetFlag(FLAGS_models_per_class);
-  // The synthetic benchmark has its own default seed; --seed changes it only when given.
-  if (absl::GetFlag(FLAGS_seed) != 0) options.seed = absl::GetFlag(FLAGS_seed);
+  // The synthetic benchmark has its own default seed; --seed (the pipeline
+  // parameter, default 0) changes it only when given.
+  MESHSEEK_ASSIGN_OR_RETURN(const RetrievalPipelineOptions pipeline, PipelineOptionsFromFlags());
+  if (pipeline.kmeans.seed != 0) options.seed = pipeline.kmeans.seed;
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   MESHSEEK_RETURN_IF_ERROR(GenerateSyntheticBenchmark(options, out_dir));
   std::printf("wrote the synthetic benchmark (%d models per class, seed %llu) to %s\n",

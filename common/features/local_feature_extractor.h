@@ -1,18 +1,17 @@
-// One entry point for every local-feature method of the paper's table, so the
-// pipeline, the CLI and (later) the extract service select a method by name
-// and never depend on which one it is.
-//
-// Methods: "dld" (DLD-SIFT, dense; dld_sift.h), "ld" (LD-SIFT, the baseline;
-// ld_sift.h) and "rld" (RLD-SIFT, resampled; rld_sift.h).
+// One entry point for every feature method, so the pipeline, the CLI and the
+// extract service select a method by name and never depend on which one it
+// is. The method table (FeatureMethods) is the one registration of a method:
+// its name, kind, measured vocabulary, validation and extraction; its
+// parameters are in common/pipeline/pipeline_params.cc.
 #ifndef MESHSEEK_COMMON_FEATURES_LOCAL_FEATURE_EXTRACTOR_H_
 #define MESHSEEK_COMMON_FEATURES_LOCAL_FEATURE_EXTRACTOR_H_
 
 #include <string>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
-#include "common/base/json.h"
 #include "common/features/dld_sift.h"
 #include "common/features/ld_sift.h"
 #include "common/features/local_features.h"
@@ -23,7 +22,37 @@ namespace meshseek {
 
 enum class FeatureMethod { kDldSift, kLdSift, kRldSift };
 
-// "dld", "ld", "rld". InvalidArgument listing the known names otherwise.
+// How a method's features become a model's signature: a bag of features over
+// a codebook learnt from the collection (the local methods), or one
+// fixed-size descriptor per model compared by the method's own distance.
+enum class DescriptorKind { kBagOfFeatures, kGlobal };
+
+struct ExtractorOptions;
+
+// The registration of one method: the table every name, listing and kind
+// lookup consults (its parameters are in common/pipeline/pipeline_params.cc).
+struct FeatureMethodInfo {
+  FeatureMethod method;
+  /// --method value, lower case.
+  const char* name;
+  /// What it is, for --help.
+  const char* title;
+  DescriptorKind kind;
+  /// The codebook size measured best for its features (bag of features).
+  int vocabulary;
+  /// Validates the method's options in ExtractorOptions.
+  absl::Status (*validate)(const ExtractorOptions& options);
+  /// Extracts one mesh's features (see ExtractLocalFeatures).
+  absl::StatusOr<LocalFeatures> (*extract)(const TriangleMesh& mesh,
+                                           const ExtractorOptions& options,
+                                           const PointGraph* resampled);
+};
+
+/// Every method, in --help order.
+const std::vector<FeatureMethodInfo>& FeatureMethods();
+const FeatureMethodInfo& FeatureMethodInfoOf(FeatureMethod method);
+
+// By name. InvalidArgument listing the known names otherwise.
 absl::StatusOr<FeatureMethod> ParseFeatureMethod(absl::string_view name);
 const char* FeatureMethodName(FeatureMethod method);
 
@@ -37,8 +66,6 @@ struct ExtractorOptions {
 
   /// Validates the options of the selected method.
   absl::Status Validate() const;
-  /// The method and its parameters, for reports (metrics.json).
-  Json ToJson() const;
 };
 
 // Extracts the local features of one mesh with the selected method, on the

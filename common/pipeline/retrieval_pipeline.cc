@@ -15,6 +15,7 @@
 #include "common/base/status_macros.h"
 #include "common/eval/distance_matrix.h"
 #include "common/geometry/mesh_io.h"
+#include "common/pipeline/pipeline_params.h"
 #include "common/search/kl_inverted_index.h"
 #include "common/search/sparse_histogram.h"
 
@@ -32,8 +33,15 @@ RetrievalPipelineOptions::RetrievalPipelineOptions() {
   // V = 2,000 is at or near the best on both; 100 training features per
   // centroid cost 0.2 points of R-precision against 256 (below the spread
   // between k-means seeds) and make k-means 2.5 times faster.
-  kmeans.num_centroids = 2000;
+  kmeans.num_centroids = FeatureMethodInfoOf(extractor.method).vocabulary;
   kmeans.max_points_per_centroid = 100;
+}
+
+RetrievalPipelineOptions RetrievalPipelineOptions::ForMethod(FeatureMethod method) {
+  RetrievalPipelineOptions options;
+  options.extractor.method = method;
+  options.kmeans.num_centroids = FeatureMethodInfoOf(method).vocabulary;
+  return options;
 }
 
 absl::Status RetrievalPipelineOptions::Validate() const {
@@ -52,19 +60,11 @@ absl::Status RetrievalPipelineOptions::Validate() const {
 }
 
 Json RetrievalPipelineOptions::ToJson() const {
-  Json json = Json::MakeObject();
-  json.Set("features", extractor.ToJson());
-  Json& codebook = json.Set("codebook", Json::MakeObject());
-  codebook.Set("vocabulary_size_V", kmeans.num_centroids);
-  codebook.Set("kmeans_seed", static_cast<int64_t>(kmeans.seed));
-  codebook.Set("kmeans_max_iterations", kmeans.max_iterations);
-  codebook.Set("kmeans_max_points_per_centroid", kmeans.max_points_per_centroid);
-  codebook.Set("kmeans_assignment", KMeansAssignmentName(kmeans.assignment));
-  codebook.Set("nearest_word_search",
-               kmeans.UsesApproximateAssignment() ? "approximate" : "exact");
-  Json& ranking = json.Set("ranking", Json::MakeObject());
-  ranking.Set("distance", "symmetric KL divergence");
-  ranking.Set("epsilon", kl.epsilon);
+  Json json = PipelineParamsToJson(*this);
+  if (FeatureMethodInfoOf(extractor.method).kind == DescriptorKind::kBagOfFeatures) {
+    json.Set("nearest_word_search", kmeans.UsesApproximateAssignment() ? "approximate" : "exact");
+    json.Set("distance", "symmetric KL divergence");
+  }
   json.Set("threads", ResolveThreadCount(num_threads));
   return json;
 }

@@ -26,7 +26,12 @@
 namespace meshseek {
 
 struct RetrievalPipelineOptions {
+  /// The defaults of DLD-SIFT.
   RetrievalPipelineOptions();
+  /// The defaults of `method`: its extractor options and its vocabulary
+  /// (FeatureMethodInfo). Selecting a method by name (pipeline_params.h)
+  /// starts from these.
+  static RetrievalPipelineOptions ForMethod(FeatureMethod method);
 
   /// Local features: the method and its parameters.
   ExtractorOptions extractor;
@@ -43,7 +48,8 @@ struct RetrievalPipelineOptions {
   bool show_progress = false;
 
   absl::Status Validate() const;
-  /// Every parameter that affects the result, for metrics.json.
+  /// Every parameter that affects the result (pipeline_params.h) and the
+  /// threads, for metrics.json.
   Json ToJson() const;
 };
 

@@ -23,7 +23,7 @@ TEST(RetrievalPipelineOptionsTest, DefaultsArePinnedAndValid) {
   EXPECT_EQ(options.extractor.dld.frame_samples_per_support, 512);
   EXPECT_EQ(options.extractor.dld.descriptor.orientation, ImageOrientation::kDominant);
   const std::string json = options.ToJson().Dump();
-  EXPECT_NE(json.find("\"vocabulary_size_V\": 2000"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"vocabulary\": 2000"), std::string::npos) << json;
 }
 
 TEST(RetrievalPipelineOptionsTest, AVocabularyTheIndexCannotHoldIsRefused) {

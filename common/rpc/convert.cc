@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/base/status_macros.h"
 #include "common/geometry/mesh_io.h"
+#include "common/pipeline/pipeline_params.h"
 
 namespace meshseek::rpc {
 namespace {
@@ -224,69 +225,72 @@ void HistogramToProto(const std::vector<float>& dense,
   }
 }
 
-absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromParams(const v1::PipelineParams& p) {
-  RetrievalPipelineOptions options;
-  ExtractorOptions& extractor = options.extractor;
+namespace {
+
+// The named values of a message written before PipelineParams.values: each
+// nonzero legacy field that applies to the method, in its old meaning (one
+// field set a value for every method that has it; zero kept the default).
+// Frozen: new parameters exist only as names.
+absl::StatusOr<ParamValues> LegacyValues(const v1::PipelineParams& p) {
+  ParamValues values;
+  FeatureMethod method = FeatureMethod::kDldSift;
   switch (p.method()) {
     case v1::FEATURE_METHOD_UNSPECIFIED:
-    case v1::FEATURE_METHOD_DLD: extractor.method = FeatureMethod::kDldSift; break;
-    case v1::FEATURE_METHOD_LD: extractor.method = FeatureMethod::kLdSift; break;
-    case v1::FEATURE_METHOD_RLD: extractor.method = FeatureMethod::kRldSift; break;
+    case v1::FEATURE_METHOD_DLD: method = FeatureMethod::kDldSift; break;
+    case v1::FEATURE_METHOD_LD: method = FeatureMethod::kLdSift; break;
+    case v1::FEATURE_METHOD_RLD: method = FeatureMethod::kRldSift; break;
     default:
       return absl::InvalidArgumentError(absl::StrCat("params: unknown method ", p.method()));
   }
-  // Zero means "the default": keep the option's own value.
-  auto set = [](auto value, auto* field) {
-    if (value != 0) *field = value;
+  values.emplace_back("method", FeatureMethodName(method));
+  auto add = [&](const char* name, auto value) {
+    const ParamSpec* spec = FindPipelineParam(name);
+    if (value != decltype(value){} && spec != nullptr && spec->AppliesTo(method)) {
+      values.emplace_back(name, absl::StrCat(value));
+    }
   };
-  set(p.scale(), &extractor.dld.scale);
-  set(p.num_points(), &extractor.dld.num_points);
-  set(p.frame_samples_per_support(), &extractor.dld.frame_samples_per_support);
-  set(p.frame_radius_factor(), &extractor.dld.frame_radius_factor);
-  if (p.has_weighted_frame()) {
-    extractor.dld.weighted_frame = p.weighted_frame();
-    extractor.rld.weighted_frame = p.weighted_frame();
+  add("scale", p.scale());
+  add("points", p.num_points());
+  add("frame_samples", p.frame_samples_per_support());
+  add("frame_radius", p.frame_radius_factor());
+  if (p.has_weighted_frame()) add("weighted_frame", p.weighted_frame() ? "true" : "false");
+  add("rld_samples", p.rld_samples());
+  add("rld_neighbors", p.rld_neighbors());
+  add("levels", p.levels());
+  add("scale_factor", method == FeatureMethod::kLdSift ? p.ld_scale_factor() : p.rld_scale_factor());
+  add("image_size", p.image_size());
+  add("orientation", p.orientation());
+  add("depth_to_gray", p.depth_to_gray());
+  add("blur_sigma", p.blur_sigma());
+  add("max_orientations", p.max_orientations());
+  add("vocabulary", p.vocabulary());
+  add("kmeans_points_per_centroid", p.kmeans_points_per_centroid());
+  add("kmeans_iterations", p.kmeans_iterations());
+  add("seed", p.seed());
+  add("kl_epsilon", p.kl_epsilon());
+  add("kmeans_assignment", p.kmeans_assignment());
+  return values;
+}
+
+}  // namespace
+
+absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromParams(const v1::PipelineParams& p) {
+  MESHSEEK_ASSIGN_OR_RETURN(ParamValues values, LegacyValues(p));
+  for (const v1::ParamValue& value : p.values()) values.emplace_back(value.name(), value.value());
+  absl::StatusOr<RetrievalPipelineOptions> options = PipelineOptionsFromValues(values);
+  if (!options.ok()) {
+    return absl::Status(options.status().code(), absl::StrCat("params: ", options.status().message()));
   }
-  set(p.rld_samples(), &extractor.rld.num_samples);
-  set(p.rld_neighbors(), &extractor.rld.neighbors);
-  set(p.levels(), &extractor.ld.scale_space.levels);
-  set(p.levels(), &extractor.rld.scale_space.levels);
-  set(p.ld_scale_factor(), &extractor.ld.scale_space.scale_factor);
-  set(p.rld_scale_factor(), &extractor.rld.scale_space.scale_factor);
-  for (DepthImageOptions* image :
-       {&extractor.dld.depth_image, &extractor.ld.depth_image, &extractor.rld.depth_image}) {
-    set(p.image_size(), &image->image_size);
-  }
-  for (SiftDescriptorOptions* d :
-       {&extractor.dld.descriptor, &extractor.ld.descriptor, &extractor.rld.descriptor}) {
-    if (p.orientation() == "dominant") {
-      d->orientation = ImageOrientation::kDominant;
-    } else if (p.orientation() == "up") {
-      d->orientation = ImageOrientation::kUpAxis;
-    } else if (!p.orientation().empty()) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "params: orientation must be 'dominant' or 'up', got '", p.orientation(), "'"));
-    }
-    if (p.depth_to_gray() == "fixed") {
-      d->depth_to_gray = DepthToGray::kFixedRange;
-    } else if (p.depth_to_gray() == "stretch") {
-      d->depth_to_gray = DepthToGray::kStretch;
-    } else if (!p.depth_to_gray().empty()) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "params: depth_to_gray must be 'fixed' or 'stretch', got '", p.depth_to_gray(), "'"));
-    }
-    set(p.blur_sigma(), &d->blur_sigma);
-    set(p.max_orientations(), &d->max_orientations);
-  }
-  set(p.vocabulary(), &options.kmeans.num_centroids);
-  set(p.kmeans_points_per_centroid(), &options.kmeans.max_points_per_centroid);
-  set(p.kmeans_iterations(), &options.kmeans.max_iterations);
-  set(p.seed(), &options.kmeans.seed);
-  MESHSEEK_ASSIGN_OR_RETURN(options.kmeans.assignment,
-                            ParseKMeansAssignment(p.kmeans_assignment()));
-  set(p.kl_epsilon(), &options.kl.epsilon);
-  MESHSEEK_RETURN_IF_ERROR(options.Validate());
   return options;
+}
+
+void PipelineParamsToProto(const RetrievalPipelineOptions& options, v1::PipelineParams* out) {
+  out->Clear();
+  for (const auto& [name, value] : PipelineValuesOf(options)) {
+    v1::ParamValue* v = out->add_values();
+    v->set_name(name);
+    v->set_value(value);
+  }
 }
 
 }  // namespace meshseek::rpc

@@ -44,9 +44,14 @@ void HistogramToProto(const std::vector<float>& dense,
                       std::size_t vocabulary_size,
                       v1::SparseHistogram* out);
 
-// Pipeline options from parameters: zero or unset fields take the core's
-// defaults. Validated (RetrievalPipelineOptions::Validate).
+// Pipeline options from parameters (the legacy fields, then the named values;
+// common/pipeline/pipeline_params.h): parameters not given take the method's
+// defaults. Validated; InvalidArgument names the parameter.
 absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromParams(const v1::PipelineParams& params);
+// The canonical parameters of `options`: every parameter of its method by
+// name, nothing in the legacy fields. PipelineOptionsFromParams reads back
+// the same options.
+void PipelineParamsToProto(const RetrievalPipelineOptions& options, v1::PipelineParams* out);
 
 }  // namespace meshseek::rpc
 

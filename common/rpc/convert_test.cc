@@ -93,7 +93,24 @@ TEST(ConvertTest, FeaturesRoundTripAndWrongDescriptorSizesAreRejected) {
       << short_descriptors;
   FeaturesToProto(features, &proto);
   proto.set_dimension(64);
-  EXPECT_NE(FeaturesFromProto(proto).status().message().find("dimension 64"), std::string::npos);
+  EXPECT_NE(FeaturesFromProto(proto).status().message().find("features of 64 (need 128)"),
+            std::string::npos)
+      << FeaturesFromProto(proto).status();
+  for (uint32_t bad : {0u, 100000u}) {
+    proto.set_dimension(bad);
+    EXPECT_NE(FeaturesFromProto(proto).status().message().find("descriptor dimension"),
+              std::string::npos);
+  }
+  // Another method's dimension travels as it is.
+  LocalFeatures other;
+  other.keypoints.resize(3);
+  other.dimension = 32;
+  other.descriptors.assign(96, 7);
+  FeaturesToProto(other, &proto);
+  const absl::StatusOr<LocalFeatures> lsf_like = FeaturesFromProto(proto);
+  ASSERT_TRUE(lsf_like.ok()) << lsf_like.status();
+  EXPECT_EQ(lsf_like->dimension, 32u);
+  EXPECT_EQ(lsf_like->descriptors, other.descriptors);
 }
 
 TEST(ConvertTest, GraphsAreCheckedOnArrival) {
@@ -179,6 +196,43 @@ TEST(ConvertTest, HistogramsAreSparseAndExact) {
   proto.add_weights(1.0f);
   EXPECT_THAT(std::string(SparseHistogramFromProto(proto, "model 'x'").status().message()),
               ::testing::HasSubstr("model 'x' has vocabulary size 4000000000"));
+}
+
+TEST(ConvertTest, NamedValuesAndTheirCanonicalFormReadBackTheSameOptions) {
+  v1::PipelineParams params;
+  for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
+           {"method", "rld"}, {"rld_samples", "5000"}, {"vocabulary", "300"}}) {
+    v1::ParamValue* v = params.add_values();
+    v->set_name(name);
+    v->set_value(value);
+  }
+  const auto options = PipelineOptionsFromParams(params);
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(options->extractor.rld.num_samples, 5000);
+  EXPECT_EQ(options->kmeans.num_centroids, 300);
+  v1::PipelineParams canonical;
+  PipelineParamsToProto(*options, &canonical);
+  EXPECT_GT(canonical.values_size(), 10);
+  EXPECT_EQ(canonical.method(), v1::FEATURE_METHOD_UNSPECIFIED);  // legacy fields stay empty
+  const auto back = PipelineOptionsFromParams(canonical);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->ToJson().Dump(), options->ToJson().Dump());
+  // The same collection written with legacy fields means the same.
+  v1::PipelineParams legacy;
+  legacy.set_method(v1::FEATURE_METHOD_RLD);
+  legacy.set_rld_samples(5000);
+  legacy.set_vocabulary(300);
+  legacy.set_num_points(64);  // DLD-SIFT's: ignored for RLD-SIFT, as it always was
+  const auto old = PipelineOptionsFromParams(legacy);
+  ASSERT_TRUE(old.ok()) << old.status();
+  EXPECT_EQ(old->ToJson().Dump(), options->ToJson().Dump());
+  // A named value that does not apply is an error (it would be ignored).
+  v1::ParamValue* wrong = params.add_values();
+  wrong->set_name("points");
+  wrong->set_value("64");
+  EXPECT_NE(PipelineOptionsFromParams(params).status().message().find(
+                "params: parameter points does not apply to method rld"),
+            std::string::npos);
 }
 
 TEST(ConvertTest, UnsetParamsAreTheCoreDefaults) {

@@ -92,21 +92,13 @@ grpc::Status CodebookService::Train(grpc::ServerContext*,
                                      " descriptor bytes are not a multiple of ", dim));
   }
   // The same k-means options as the in-process pipeline's
-  // TrainCollectionCodebook: the defaults, then the five that are parameters.
-  KMeansOptions kmeans;
-  absl::StatusOr<KMeansOptions::Assignment> assignment =
-      ParseKMeansAssignment(first.kmeans_assignment());
-  if (!assignment.ok()) {
+  // TrainCollectionCodebook: the collection's.
+  absl::StatusOr<RetrievalPipelineOptions> params = rpc::PipelineOptionsFromParams(first.params());
+  if (!params.ok()) {
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                        absl::StrCat("train ", id, ": ", assignment.status().message()));
+                        absl::StrCat("train ", id, ": ", params.status().message()));
   }
-  kmeans.assignment = *assignment;
-  if (first.vocabulary() > 0) kmeans.num_centroids = first.vocabulary();
-  if (first.kmeans_points_per_centroid() > 0) {
-    kmeans.max_points_per_centroid = first.kmeans_points_per_centroid();
-  }
-  if (first.kmeans_iterations() > 0) kmeans.max_iterations = first.kmeans_iterations();
-  kmeans.seed = first.seed();
+  KMeansOptions kmeans = params->kmeans;
   kmeans.num_threads = options_.num_threads;
   const std::size_t count = descriptors.size() / dim;
   absl::StatusOr<Codebook> codebook = Codebook::Train(

@@ -104,11 +104,7 @@ absl::Status BuildRunner::Train(const std::string& codebook_id,
         auto writer = codebook->Train(&context, &trained);
         v1::TrainCodebookRequest chunk;
         chunk.set_codebook_id(codebook_id);
-        chunk.set_vocabulary(info.options.kmeans.num_centroids);
-        chunk.set_kmeans_points_per_centroid(info.options.kmeans.max_points_per_centroid);
-        chunk.set_kmeans_iterations(info.options.kmeans.max_iterations);
-        chunk.set_kmeans_assignment(KMeansAssignmentName(info.options.kmeans.assignment));
-        chunk.set_seed(info.options.kmeans.seed);
+        *chunk.mutable_params() = info.params;
         // One dimension per method; the codebook service checks every chunk.
         for (const v1::LocalFeatures& f : features) {
           if (f.count() > 0) {

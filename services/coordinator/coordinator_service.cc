@@ -89,12 +89,26 @@ grpc::Status CoordinatorService::CreateCollection(grpc::ServerContext*,
   if (absl::Status name = CheckName("collection name", request->name(), 128, true); !name.ok()) {
     return rpc::ToGrpcStatus(name);
   }
-  if (absl::StatusOr<RetrievalPipelineOptions> valid =
-          rpc::PipelineOptionsFromParams(request->params());
-      !valid.ok()) {
+  absl::StatusOr<RetrievalPipelineOptions> valid = rpc::PipelineOptionsFromParams(request->params());
+  if (!valid.ok()) {
     return rpc::ToGrpcStatus(Prefixed(valid.status(), absl::StrCat("collection '", request->name(), "': ")));
   }
-  if (absl::Status s = store_->CreateCollection(request->name(), request->params()); !s.ok()) {
+  // Stored canonical: every parameter of the method with its value, so the
+  // collection keeps its meaning when a default changes, and creating it
+  // again with the same parameters however written is not a conflict.
+  v1::PipelineParams canonical;
+  rpc::PipelineParamsToProto(*valid, &canonical);
+  if (absl::StatusOr<StoredCollection> existing = store_->GetCollection(request->name());
+      existing.ok()) {
+    absl::StatusOr<RetrievalPipelineOptions> stored = rpc::PipelineOptionsFromParams(existing->params);
+    v1::PipelineParams stored_canonical;
+    if (stored.ok()) rpc::PipelineParamsToProto(*stored, &stored_canonical);
+    if (!stored.ok() ||
+        stored_canonical.SerializeAsString() != canonical.SerializeAsString()) {
+      return grpc::Status(grpc::StatusCode::ALREADY_EXISTS,
+                          absl::StrCat("collection '", request->name(), "' exists with other parameters"));
+    }
+  } else if (absl::Status s = store_->CreateCollection(request->name(), canonical); !s.ok()) {
     return rpc::ToGrpcStatus(s);
   }
   absl::StatusOr<v1::Collection> collection = DescribeCollection(request->name());

@@ -1,0 +1,394 @@
+#include "common/pipeline/pipeline_params.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstdint>
+#include <limits>
+#include <set>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "common/base/status_macros.h"
+#include "common/search/sparse_histogram.h"
+
+namespace meshseek {
+namespace {
+
+using Options = RetrievalPipelineOptions;
+using Scope = ParamSpec::Scope;
+constexpr FeatureMethod kDld = FeatureMethod::kDldSift;
+constexpr FeatureMethod kLd = FeatureMethod::kLdSift;
+constexpr FeatureMethod kRld = FeatureMethod::kRldSift;
+
+// Canonical text of a value: integers in full, doubles shortest round-trip.
+std::string Text(int v) { return absl::StrCat(v); }
+std::string Text(uint64_t v) { return absl::StrCat(v); }
+std::string Text(bool v) { return v ? "true" : "false"; }
+std::string Text(double v) {
+  // Six significant digits when they read back to the same double (every
+  // default), all seventeen otherwise.
+  std::string text = absl::StrCat(v);
+  if (std::strtod(text.c_str(), nullptr) == v) return text;
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", v);
+  return buffer;
+}
+
+template <typename T>
+ParamType TypeOf();
+template <>
+ParamType TypeOf<int>() { return ParamType::kInt; }
+template <>
+ParamType TypeOf<uint64_t>() { return ParamType::kUint64; }
+template <>
+ParamType TypeOf<double>() { return ParamType::kDouble; }
+template <>
+ParamType TypeOf<bool>() { return ParamType::kBool; }
+
+void Parse(absl::string_view text, int* v) { (void)absl::SimpleAtoi(text, v); }
+void Parse(absl::string_view text, uint64_t* v) { (void)absl::SimpleAtoi(text, v); }
+void Parse(absl::string_view text, double* v) { (void)absl::SimpleAtod(text, v); }
+void Parse(absl::string_view text, bool* v) { *v = text == "true"; }
+
+// A parameter stored in one field of the selected method's options: `field`
+// returns that field (it may look at options.extractor.method).
+template <typename T>
+ParamSpec Field(std::string name, std::string doc, double min, double max, Scope scope,
+                std::vector<FeatureMethod> methods, T& (*field)(Options&)) {
+  ParamSpec spec;
+  spec.name = std::move(name);
+  spec.type = TypeOf<T>();
+  spec.doc = std::move(doc);
+  spec.min = min;
+  spec.max = max;
+  spec.scope = scope;
+  spec.methods = std::move(methods);
+  spec.get = [field](const Options& o) { return Text(field(const_cast<Options&>(o))); };
+  spec.set = [field](absl::string_view text, Options* o) { Parse(text, &field(*o)); };
+  return spec;
+}
+
+// A parameter with named values stored as an enumerator.
+template <typename E>
+ParamSpec Choice(std::string name, std::string doc, Scope scope,
+                 std::vector<FeatureMethod> methods, E& (*field)(Options&),
+                 std::vector<std::pair<std::string, E>> values) {
+  ParamSpec spec;
+  spec.name = std::move(name);
+  spec.type = ParamType::kChoice;
+  spec.doc = std::move(doc);
+  spec.scope = scope;
+  spec.methods = std::move(methods);
+  for (const auto& [text, value] : values) spec.choices.push_back(text);
+  spec.get = [field, values](const Options& o) {
+    const E current = field(const_cast<Options&>(o));
+    for (const auto& [text, value] : values) {
+      if (value == current) return text;
+    }
+    return std::string("?");
+  };
+  spec.set = [field, values](absl::string_view text, Options* o) {
+    for (const auto& [name, value] : values) {
+      if (name == text) field(*o) = value;
+    }
+  };
+  return spec;
+}
+
+// The sub-options every SIFT method has, of the selected method.
+DepthImageOptions& DepthImage(Options& o) {
+  switch (o.extractor.method) {
+    case kLd: return o.extractor.ld.depth_image;
+    case kRld: return o.extractor.rld.depth_image;
+    default: return o.extractor.dld.depth_image;
+  }
+}
+SiftDescriptorOptions& Sift(Options& o) {
+  switch (o.extractor.method) {
+    case kLd: return o.extractor.ld.descriptor;
+    case kRld: return o.extractor.rld.descriptor;
+    default: return o.extractor.dld.descriptor;
+  }
+}
+ScaleSpaceOptions& ScaleSpace(Options& o) {
+  return o.extractor.method == kLd ? o.extractor.ld.scale_space : o.extractor.rld.scale_space;
+}
+
+std::vector<ParamSpec> MakeSpecs() {
+  std::vector<ParamSpec> specs;
+  {
+    ParamSpec method;
+    method.name = "method";
+    method.type = ParamType::kChoice;
+    method.scope = Scope::kAll;
+    std::vector<std::string> titles;
+    for (const FeatureMethodInfo& info : FeatureMethods()) {
+      method.choices.push_back(info.name);
+      titles.push_back(absl::StrCat(info.name, " (", info.title, ")"));
+    }
+    method.doc = absl::StrCat("feature method: ", absl::StrJoin(titles, " | "));
+    method.get = [](const Options& o) { return std::string(FeatureMethodName(o.extractor.method)); };
+    method.set = [](absl::string_view text, Options* o) {
+      *o = Options::ForMethod(*ParseFeatureMethod(text));
+    };
+    specs.push_back(std::move(method));
+  }
+  const Scope listed = Scope::kListed;
+  specs.push_back(Field<double>(
+      "scale", "support radius E relative to the minimum enclosing sphere (s = E * D / 2)", 1e-6, 2,
+      listed, {kDld}, +[](Options& o) -> double& { return o.extractor.dld.scale; }));
+  specs.push_back(Field<int>("points", "feature points per model (N_DLD)", 1, 1000000, listed,
+                             {kDld}, +[](Options& o) -> int& { return o.extractor.dld.num_points; }));
+  specs.push_back(Field<int>(
+      "frame_samples", "dense surface samples per support disc for the local PCA frame", 8, 1000000,
+      listed, {kDld},
+      +[](Options& o) -> int& { return o.extractor.dld.frame_samples_per_support; }));
+  specs.push_back(Field<double>(
+      "frame_radius", "the local frame uses the samples within this many support radii", 0.25, 4,
+      listed, {kDld}, +[](Options& o) -> double& { return o.extractor.dld.frame_radius_factor; }));
+  specs.push_back(Field<bool>(
+      "weighted_frame", "distance-weighted (SHOT-style) PCA frame instead of plain PCA", 0, 1,
+      listed, {kDld, kRld}, +[](Options& o) -> bool& {
+        return o.extractor.method == kRld ? o.extractor.rld.weighted_frame
+                                          : o.extractor.dld.weighted_frame;
+      }));
+  specs.push_back(Field<int>("rld_samples", "resample points (N_RLD)", 100, 10000000, listed,
+                             {kRld},
+                             +[](Options& o) -> int& { return o.extractor.rld.num_samples; }));
+  specs.push_back(Field<int>("rld_neighbors", "k of the k-nearest-neighbour graph", 1, 100, listed,
+                             {kRld}, +[](Options& o) -> int& { return o.extractor.rld.neighbors; }));
+  specs.push_back(Field<int>("levels", "scale-space levels L", 2, 200, listed, {kLd, kRld},
+                             +[](Options& o) -> int& { return ScaleSpace(o).levels; }));
+  specs.push_back(Field<double>(
+      "scale_factor", "C in the feature scale s = C * d * sqrt(level)", 1e-6, 1e6, listed,
+      {kLd, kRld}, +[](Options& o) -> double& { return ScaleSpace(o).scale_factor; }));
+  specs.push_back(Field<int>("image_size", "local depth image side I in pixels (odd)", 3, 255,
+                             listed, {kDld, kLd, kRld},
+                             +[](Options& o) -> int& { return DepthImage(o).image_size; }));
+  specs.push_back(Choice<ImageOrientation>(
+      "orientation", "descriptor rotation: Lowe's gradient peaks | PCA up axis + 180-degree sum",
+      listed, {kDld, kLd, kRld},
+      +[](Options& o) -> ImageOrientation& { return Sift(o).orientation; },
+      {{"dominant", ImageOrientation::kDominant}, {"up", ImageOrientation::kUpAxis}}));
+  specs.push_back(Choice<DepthToGray>(
+      "depth_to_gray", "depth to grey: fixed (2s range) | stretch (image range)", listed,
+      {kDld, kLd, kRld}, +[](Options& o) -> DepthToGray& { return Sift(o).depth_to_gray; },
+      {{"fixed", DepthToGray::kFixedRange}, {"stretch", DepthToGray::kStretch}}));
+  specs.push_back(Field<int>(
+      "max_orientations",
+      "with dominant orientation: at most this many descriptors per image (0: every peak within "
+      "80 % of the highest)",
+      0, 36, listed, {kDld, kLd, kRld},
+      +[](Options& o) -> int& { return Sift(o).max_orientations; }));
+  specs.push_back(Field<double>("blur_sigma", "SIFT blur sigma in pixels", 0.5, 5, listed,
+                                {kDld, kLd, kRld},
+                                +[](Options& o) -> double& { return Sift(o).blur_sigma; }));
+  const Scope bag = Scope::kBagOfFeatures;
+  specs.push_back(Field<int>("vocabulary", "codebook size V (k-means centroids)", 1,
+                             static_cast<double>(kMaxVocabulary), bag, {},
+                             +[](Options& o) -> int& { return o.kmeans.num_centroids; }));
+  specs.push_back(Field<int>(
+      "kmeans_points_per_centroid", "k-means trains on at most this many features per centroid", 1,
+      1000000, bag, {}, +[](Options& o) -> int& { return o.kmeans.max_points_per_centroid; }));
+  specs.push_back(Field<int>("kmeans_iterations", "maximum k-means iterations", 1, 10000, bag, {},
+                             +[](Options& o) -> int& { return o.kmeans.max_iterations; }));
+  specs.push_back(Choice<KMeansOptions::Assignment>(
+      "kmeans_assignment",
+      "nearest-word search of k-means and encoding: auto (exact below V = 1,000, approximate "
+      "from there) | exact | approximate",
+      bag, {}, +[](Options& o) -> KMeansOptions::Assignment& { return o.kmeans.assignment; },
+      {{"auto", KMeansOptions::Assignment::kAuto},
+       {"exact", KMeansOptions::Assignment::kExact},
+       {"approximate", KMeansOptions::Assignment::kApproximate}}));
+  specs.push_back(Field<uint64_t>("seed", "seed of k-means sampling and seeding", 0,
+                                  static_cast<double>(std::numeric_limits<uint64_t>::max()), bag,
+                                  {}, +[](Options& o) -> uint64_t& { return o.kmeans.seed; }));
+  specs.push_back(Field<double>(
+      "kl_epsilon", "mass added to every histogram bin before KL divergence (zero-bin rule)",
+      1e-30, 0.5, bag, {}, +[](Options& o) -> double& { return o.kl.epsilon; }));
+  return specs;
+}
+
+// Parses and range-checks `text` as the spec's type.
+absl::Status CheckValue(const ParamSpec& spec, absl::string_view text) {
+  auto bad = [&]() {
+    return absl::InvalidArgumentError(absl::StrCat("parameter ", spec.name, ": '", text,
+                                                   "' is not ", spec.TypeDescription()));
+  };
+  switch (spec.type) {
+    case ParamType::kInt: {
+      int v;
+      if (!absl::SimpleAtoi(text, &v) || v < spec.min || v > spec.max) return bad();
+      return absl::OkStatus();
+    }
+    case ParamType::kUint64: {
+      uint64_t v;
+      if (!absl::SimpleAtoi(text, &v) || static_cast<double>(v) < spec.min) return bad();
+      return absl::OkStatus();
+    }
+    case ParamType::kDouble: {
+      double v;
+      if (!absl::SimpleAtod(text, &v) || !std::isfinite(v) || v < spec.min || v > spec.max) {
+        return bad();
+      }
+      return absl::OkStatus();
+    }
+    case ParamType::kBool:
+      if (text != "true" && text != "false") return bad();
+      return absl::OkStatus();
+    case ParamType::kChoice:
+      for (const std::string& choice : spec.choices) {
+        if (choice == text) return absl::OkStatus();
+      }
+      return bad();
+  }
+  return bad();
+}
+
+std::string MethodNames(const ParamSpec& spec) {
+  switch (spec.scope) {
+    case Scope::kAll: return "every method";
+    case Scope::kBagOfFeatures: return "bag-of-features methods";
+    case Scope::kListed: break;
+  }
+  std::vector<std::string> names;
+  for (FeatureMethod m : spec.methods) names.push_back(FeatureMethodName(m));
+  return absl::StrJoin(names, ", ");
+}
+
+}  // namespace
+
+bool ParamSpec::AppliesTo(FeatureMethod method) const {
+  switch (scope) {
+    case Scope::kAll: return true;
+    case Scope::kBagOfFeatures:
+      return FeatureMethodInfoOf(method).kind == DescriptorKind::kBagOfFeatures;
+    case Scope::kListed:
+      for (FeatureMethod m : methods) {
+        if (m == method) return true;
+      }
+      return false;
+  }
+  return false;
+}
+
+std::string ParamSpec::TypeDescription() const {
+  switch (type) {
+    case ParamType::kInt:
+      return absl::StrCat("an integer in [", static_cast<int64_t>(min), ", ",
+                          static_cast<int64_t>(max), "]");
+    case ParamType::kUint64: return "an unsigned 64-bit integer";
+    case ParamType::kDouble: return absl::StrCat("a number in [", Text(min), ", ", Text(max), "]");
+    case ParamType::kBool: return "true or false";
+    case ParamType::kChoice: return absl::StrCat("one of ", absl::StrJoin(choices, ", "));
+  }
+  return "?";
+}
+
+const std::vector<ParamSpec>& PipelineParamSpecs() {
+  static const auto* const kSpecs = new std::vector<ParamSpec>(MakeSpecs());
+  return *kSpecs;
+}
+
+const ParamSpec* FindPipelineParam(absl::string_view name) {
+  for (const ParamSpec& spec : PipelineParamSpecs()) {
+    if (spec.name == name) return &spec;
+  }
+  return nullptr;
+}
+
+absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromValues(const ParamValues& values) {
+  // The method decides every other parameter's default and meaning.
+  std::string method = FeatureMethodName(FeatureMethod::kDldSift);
+  for (const auto& [name, value] : values) {
+    if (name == "method") method = value;
+  }
+  const ParamSpec& method_spec = PipelineParamSpecs().front();
+  MESHSEEK_RETURN_IF_ERROR(CheckValue(method_spec, method));
+  Options options;
+  method_spec.set(method, &options);
+  for (const auto& [name, value] : values) {
+    if (name == "method") continue;
+    const ParamSpec* spec = FindPipelineParam(name);
+    if (spec == nullptr) {
+      std::vector<std::string> known;
+      for (const ParamSpec& s : PipelineParamSpecs()) known.push_back(s.name);
+      return absl::InvalidArgumentError(absl::StrCat("unknown parameter '", name,
+                                                     "' (known: ", absl::StrJoin(known, ", "), ")"));
+    }
+    if (!spec->AppliesTo(options.extractor.method)) {
+      return absl::InvalidArgumentError(absl::StrCat("parameter ", name, " does not apply to method ",
+                                                     method, " (it applies to ",
+                                                     MethodNames(*spec), ")"));
+    }
+    MESHSEEK_RETURN_IF_ERROR(CheckValue(*spec, value));
+    spec->set(value, &options);
+  }
+  MESHSEEK_RETURN_IF_ERROR(options.Validate());
+  return options;
+}
+
+ParamValues PipelineValuesOf(const RetrievalPipelineOptions& options) {
+  ParamValues values;
+  for (const ParamSpec& spec : PipelineParamSpecs()) {
+    if (spec.AppliesTo(options.extractor.method)) values.emplace_back(spec.name, spec.get(options));
+  }
+  return values;
+}
+
+Json PipelineParamsToJson(const RetrievalPipelineOptions& options) {
+  Json json = Json::MakeObject();
+  for (const ParamSpec& spec : PipelineParamSpecs()) {
+    if (!spec.AppliesTo(options.extractor.method)) continue;
+    const std::string text = spec.get(options);
+    switch (spec.type) {
+      case ParamType::kInt:
+      case ParamType::kUint64: {
+        int64_t v = 0;
+        if (absl::SimpleAtoi(text, &v)) {
+          json.Set(spec.name, v);
+        } else {
+          json.Set(spec.name, text);  // a uint64 beyond int64: exact as text
+        }
+        break;
+      }
+      case ParamType::kDouble: {
+        double v = 0;
+        (void)absl::SimpleAtod(text, &v);
+        json.Set(spec.name, v);
+        break;
+      }
+      case ParamType::kBool: json.Set(spec.name, text == "true"); break;
+      case ParamType::kChoice: json.Set(spec.name, text); break;
+    }
+  }
+  return json;
+}
+
+std::string PipelineParamsUsage() {
+  std::string usage = "Pipeline parameters (--name=value; each applies to the methods named):\n";
+  for (const ParamSpec& spec : PipelineParamSpecs()) {
+    // "default: 20" when every method has the same, else "default: rld 15, ld 20".
+    std::vector<std::string> defaults;
+    std::set<std::string> distinct;
+    for (const FeatureMethodInfo& info : FeatureMethods()) {
+      if (spec.name == "method" || !spec.AppliesTo(info.method)) continue;
+      const std::string value = spec.get(Options::ForMethod(info.method));
+      defaults.push_back(absl::StrCat(info.name, " ", value));
+      distinct.insert(value);
+    }
+    if (distinct.size() == 1) defaults = {*distinct.begin()};
+    absl::StrAppend(&usage, "  --", spec.name, "  ", spec.TypeDescription(), "; ", spec.doc, "\n");
+    if (spec.name == "method") {
+      absl::StrAppend(&usage, "      default: ", FeatureMethodName(FeatureMethod::kDldSift), "\n");
+    } else {
+      absl::StrAppend(&usage, "      ", MethodNames(spec), "; default: ",
+                      absl::StrJoin(defaults, ", "), "\n");
+    }
+  }
+  return usage;
+}
+
+}  // namespace meshseek
