@@ -26,6 +26,12 @@ absl::StatusOr<LocalFeatures> ExtractRld(const TriangleMesh& mesh,
   return ExtractRldSift(mesh, options.rld);
 }
 
+absl::StatusOr<LocalFeatures> ExtractBf(const TriangleMesh& mesh,
+                                        const ExtractorOptions& options,
+                                        const PointGraph*) {
+  return ExtractBfDsift(mesh, options.bfdsift);
+}
+
 }  // namespace
 
 const std::vector<FeatureMethodInfo>& FeatureMethods() {
@@ -39,6 +45,10 @@ const std::vector<FeatureMethodInfo>& FeatureMethods() {
       {FeatureMethod::kLdSift, "ld", "LD-SIFT (Darom & Keller): salient points on the mesh",
        DescriptorKind::kBagOfFeatures, 2000,
        [](const ExtractorOptions& o) { return o.ld.Validate(); }, ExtractLd},
+      {FeatureMethod::kBfDsift, "bfdsift",
+       "BF-DSIFT (Furuya & Ohbuchi): dense SIFT on depth views of the whole model",
+       DescriptorKind::kBagOfFeatures, 8000,
+       [](const ExtractorOptions& o) { return o.bfdsift.Validate(); }, ExtractBf},
   };
   return *kMethods;
 }
@@ -61,6 +71,23 @@ absl::StatusOr<FeatureMethod> ParseFeatureMethod(absl::string_view name) {
 }
 
 const char* FeatureMethodName(FeatureMethod method) { return FeatureMethodInfoOf(method).name; }
+
+absl::StatusOr<float> GlobalDistance(FeatureMethod method,
+                                     const LocalFeatures& a,
+                                     const LocalFeatures& b) {
+  const FeatureMethodInfo& info = FeatureMethodInfoOf(method);
+  if (info.kind != DescriptorKind::kGlobal || info.distance == nullptr) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("method ", info.name, " has no global descriptor distance"));
+  }
+  if (a.size() != 1 || b.size() != 1 || a.dimension != b.dimension ||
+      a.descriptors.size() != a.dimension || b.descriptors.size() != b.dimension) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "method ", info.name, ": a global descriptor is one feature of one dimension, got ",
+        a.size(), " of ", a.dimension, " and ", b.size(), " of ", b.dimension));
+  }
+  return info.distance(a.descriptors.data(), b.descriptors.data(), a.dimension);
+}
 
 absl::Status ExtractorOptions::Validate() const { return FeatureMethodInfoOf(method).validate(*this); }
 

@@ -12,6 +12,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "common/features/bf_dsift.h"
 #include "common/features/dld_sift.h"
 #include "common/features/ld_sift.h"
 #include "common/features/local_features.h"
@@ -20,7 +21,7 @@
 
 namespace meshseek {
 
-enum class FeatureMethod { kDldSift, kLdSift, kRldSift };
+enum class FeatureMethod { kDldSift, kLdSift, kRldSift, kBfDsift };
 
 // How a method's features become a model's signature: a bag of features over
 // a codebook learnt from the collection (the local methods), or one
@@ -46,7 +47,17 @@ struct FeatureMethodInfo {
   absl::StatusOr<LocalFeatures> (*extract)(const TriangleMesh& mesh,
                                            const ExtractorOptions& options,
                                            const PointGraph* resampled);
+  /// kGlobal: the distance of two models' descriptors (GlobalDescriptorFeatures)
+  /// of `dimension` bytes; symmetric, 0 for equal ones. nullptr otherwise.
+  float (*distance)(const uint8_t* a, const uint8_t* b, std::size_t dimension) = nullptr;
 };
+
+/// The distance of a global method between two models' features; InvalidArgument
+/// when the method is not global or either is not one descriptor of the same
+/// dimension.
+absl::StatusOr<float> GlobalDistance(FeatureMethod method,
+                                     const LocalFeatures& a,
+                                     const LocalFeatures& b);
 
 /// Every method, in --help order.
 const std::vector<FeatureMethodInfo>& FeatureMethods();
@@ -63,6 +74,7 @@ struct ExtractorOptions {
   DldSiftOptions dld;
   LdSiftOptions ld;
   RldSiftOptions rld;
+  BfDsiftOptions bfdsift;
 
   /// Validates the options of the selected method.
   absl::Status Validate() const;

@@ -21,6 +21,7 @@ using Scope = ParamSpec::Scope;
 constexpr FeatureMethod kDld = FeatureMethod::kDldSift;
 constexpr FeatureMethod kLd = FeatureMethod::kLdSift;
 constexpr FeatureMethod kRld = FeatureMethod::kRldSift;
+constexpr FeatureMethod kBf = FeatureMethod::kBfDsift;
 
 // Canonical text of a value: integers in full, doubles shortest round-trip.
 std::string Text(int v) { return absl::StrCat(v); }
@@ -102,6 +103,7 @@ DepthImageOptions& DepthImage(Options& o) {
   switch (o.extractor.method) {
     case kLd: return o.extractor.ld.depth_image;
     case kRld: return o.extractor.rld.depth_image;
+    case kBf: return o.extractor.bfdsift.patch_image;
     default: return o.extractor.dld.depth_image;
   }
 }
@@ -109,6 +111,7 @@ SiftDescriptorOptions& Sift(Options& o) {
   switch (o.extractor.method) {
     case kLd: return o.extractor.ld.descriptor;
     case kRld: return o.extractor.rld.descriptor;
+    case kBf: return o.extractor.bfdsift.descriptor;
     default: return o.extractor.dld.descriptor;
   }
 }
@@ -164,26 +167,41 @@ std::vector<ParamSpec> MakeSpecs() {
   specs.push_back(Field<double>(
       "scale_factor", "C in the feature scale s = C * d * sqrt(level)", 1e-6, 1e6, listed,
       {kLd, kRld}, +[](Options& o) -> double& { return ScaleSpace(o).scale_factor; }));
+  specs.push_back(Field<int>(
+      "view_level", "view directions: vertices of the icosahedron subdivided this often (1: 42)",
+      0, 3, listed, {kBf}, +[](Options& o) -> int& { return o.extractor.bfdsift.view_level; }));
+  specs.push_back(Field<int>("view_size", "side of each whole-model view in pixels", 32, 1024,
+                             listed, {kBf},
+                             +[](Options& o) -> int& { return o.extractor.bfdsift.view_size; }));
+  specs.push_back(Field<int>(
+      "points_per_view", "dense grid points per view inside the silhouette", 1, 100000, listed,
+      {kBf}, +[](Options& o) -> int& { return o.extractor.bfdsift.points_per_view; }));
+  specs.push_back(Field<double>(
+      "patch_radius", "smallest SIFT patch radius relative to the view's side", 1e-3, 0.5, listed,
+      {kBf}, +[](Options& o) -> double& { return o.extractor.bfdsift.patch_radius; }));
+  specs.push_back(Field<int>(
+      "patch_scales", "patch radii per point: patch_radius, twice it, ...", 1, 4, listed, {kBf},
+      +[](Options& o) -> int& { return o.extractor.bfdsift.patch_scales; }));
   specs.push_back(Field<int>("image_size", "local depth image side I in pixels (odd)", 3, 255,
-                             listed, {kDld, kLd, kRld},
+                             listed, {kDld, kLd, kRld, kBf},
                              +[](Options& o) -> int& { return DepthImage(o).image_size; }));
   specs.push_back(Choice<ImageOrientation>(
       "orientation", "descriptor rotation: Lowe's gradient peaks | PCA up axis + 180-degree sum",
-      listed, {kDld, kLd, kRld},
+      listed, {kDld, kLd, kRld, kBf},
       +[](Options& o) -> ImageOrientation& { return Sift(o).orientation; },
       {{"dominant", ImageOrientation::kDominant}, {"up", ImageOrientation::kUpAxis}}));
   specs.push_back(Choice<DepthToGray>(
       "depth_to_gray", "depth to grey: fixed (2s range) | stretch (image range)", listed,
-      {kDld, kLd, kRld}, +[](Options& o) -> DepthToGray& { return Sift(o).depth_to_gray; },
+      {kDld, kLd, kRld, kBf}, +[](Options& o) -> DepthToGray& { return Sift(o).depth_to_gray; },
       {{"fixed", DepthToGray::kFixedRange}, {"stretch", DepthToGray::kStretch}}));
   specs.push_back(Field<int>(
       "max_orientations",
       "with dominant orientation: at most this many descriptors per image (0: every peak within "
       "80 % of the highest)",
-      0, 36, listed, {kDld, kLd, kRld},
+      0, 36, listed, {kDld, kLd, kRld, kBf},
       +[](Options& o) -> int& { return Sift(o).max_orientations; }));
   specs.push_back(Field<double>("blur_sigma", "SIFT blur sigma in pixels", 0.5, 5, listed,
-                                {kDld, kLd, kRld},
+                                {kDld, kLd, kRld, kBf},
                                 +[](Options& o) -> double& { return Sift(o).blur_sigma; }));
   const Scope bag = Scope::kBagOfFeatures;
   specs.push_back(Field<int>("vocabulary", "codebook size V (k-means centroids)", 1,

@@ -20,8 +20,8 @@ absl::Status ViewRenderOptions::Validate() const {
   return absl::OkStatus();
 }
 
-ViewFrame FrameFor(const Vec3d& direction) {
-  ViewFrame frame;
+ViewCamera CameraFor(const Vec3d& direction) {
+  ViewCamera frame;
   frame.direction = Normalized(direction);
   const Vec3d& d = frame.direction;
   // The world axis least aligned with d, made orthogonal to it.
@@ -66,7 +66,7 @@ absl::StatusOr<ViewRenderer> ViewRenderer::Create(const TriangleMesh& mesh,
   return renderer;
 }
 
-ViewImage ViewRenderer::Render(const ViewFrame& frame) const {
+ViewImage ViewRenderer::Render(const ViewCamera& frame) const {
   const int n = options_.image_size;
   const double half = 0.5 * n;
   const double to_pixels = half / options_.window_scale;

@@ -5,7 +5,7 @@
 // and Fourier descriptors.
 //
 // Geometry. The mesh is moved and scaled so that its enclosing sphere is the
-// unit sphere. A view looks along a unit direction d; its frame (FrameFor)
+// unit sphere. A view looks along a unit direction d; its frame (CameraFor)
 // has right x up = -d. A surface point p lands on the pixel whose centre is
 // nearest (dot(p, right), dot(p, up)) / window_scale, row 0 at the top, and
 // its depth is (1 - dot(p, d)) / 2: 1 at the sphere's pole nearest the
@@ -56,12 +56,12 @@ struct ViewImage {
 /// The camera frame of a view direction: `right` and `up` span the image,
 /// right x up = -direction. Deterministic: up is the world axis least
 /// aligned with the direction, made orthogonal.
-struct ViewFrame {
+struct ViewCamera {
   Vec3d direction;
   Vec3d right;
   Vec3d up;
 };
-ViewFrame FrameFor(const Vec3d& direction);
+ViewCamera CameraFor(const Vec3d& direction);
 
 class ViewRenderer {
  public:
@@ -70,8 +70,8 @@ class ViewRenderer {
   static absl::StatusOr<ViewRenderer> Create(const TriangleMesh& mesh,
                                              const ViewRenderOptions& options);
 
-  ViewImage Render(const Vec3d& direction) const { return Render(FrameFor(direction)); }
-  ViewImage Render(const ViewFrame& frame) const;
+  ViewImage Render(const Vec3d& direction) const { return Render(CameraFor(direction)); }
+  ViewImage Render(const ViewCamera& frame) const;
 
   /// The enclosing sphere the views are framed by, in the mesh's coordinates.
   const Sphere& sphere() const { return sphere_; }

@@ -19,7 +19,7 @@ void WindowCoordinates(int x, int y, int n, double* u, double* v) {
 
 TEST(ViewFrameTest, FramesAreOrthonormalAndRightHanded) {
   for (const Vec3d& d : IcosphereDirections(2)) {
-    const ViewFrame f = FrameFor(d * 3.0);
+    const ViewCamera f = CameraFor(d * 3.0);
     EXPECT_NEAR(Norm(f.direction), 1.0, 1e-12);
     EXPECT_NEAR(Norm(f.right), 1.0, 1e-12);
     EXPECT_NEAR(Norm(f.up), 1.0, 1e-12);
@@ -88,7 +88,7 @@ TEST(ViewRendererTest, BoxMatchesAnalyticDepthAlongTheAxes) {
   EXPECT_NEAR(radius, std::sqrt(1.5 * 1.5 + 2.0), 1e-6);
   const Vec3d lo(-1, -1, -1), hi(2, 1, 1);
   for (const Vec3d& d : {Vec3d(1, 0, 0), Vec3d(-1, 0, 0), Vec3d(0, 1, 0), Vec3d(0, 0, -1)}) {
-    const ViewFrame frame = FrameFor(d);
+    const ViewCamera frame = CameraFor(d);
     const ViewImage image = renderer->Render(frame);
     // The near face: the box's extreme along -d.
     double near = 0;
