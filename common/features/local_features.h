@@ -8,6 +8,7 @@
 #define MESHSEEK_COMMON_FEATURES_LOCAL_FEATURES_H_
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "common/features/sift_descriptor.h"
@@ -25,7 +26,7 @@ struct Keypoint {
 
 /// Bound on a descriptor's dimension: what a peer may declare before its
 /// bytes are trusted.
-inline constexpr std::size_t kMaxDescriptorDimension = 1024;
+inline constexpr std::size_t kMaxDescriptorDimension = 16384;
 
 struct LocalFeatures {
   std::vector<Keypoint> keypoints;
@@ -36,6 +37,17 @@ struct LocalFeatures {
   std::size_t size() const { return keypoints.size(); }
   const uint8_t* descriptor(std::size_t i) const { return descriptors.data() + i * dimension; }
 };
+
+/// A global method's output in the same form: one feature whose descriptor is
+/// the model's whole fixed-size descriptor (its keypoint is all zeros), so
+/// that extraction, transport and storage are the same for every method.
+inline LocalFeatures GlobalDescriptorFeatures(std::vector<uint8_t> bytes) {
+  LocalFeatures features;
+  features.dimension = bytes.size();
+  features.descriptors = std::move(bytes);
+  features.keypoints.resize(1, Keypoint{Vec3f(0, 0, 0), Vec3f(0, 0, 0), Vec3f(0, 0, 0), 0, 0});
+  return features;
+}
 
 }  // namespace meshseek
 

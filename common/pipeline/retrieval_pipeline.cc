@@ -192,6 +192,33 @@ absl::StatusOr<std::vector<float>> RankCollection(const std::vector<std::vector<
   return index->DistanceMatrix(docs, options.num_threads);
 }
 
+absl::StatusOr<std::vector<float>> RankGlobalCollection(const std::vector<LocalFeatures>& features,
+                                                        const RetrievalPipelineOptions& options) {
+  const std::size_t n = features.size();
+  const FeatureMethod method = options.extractor.method;
+  std::vector<float> distances(n * n, 0.0f);
+  std::vector<absl::Status> errors(n);
+  // Row i computes the pairs (i, j > i); rows are interleaved so that both
+  // ends of the triangle share the threads.
+  ParallelFor(n, options.num_threads, [&](std::size_t k) {
+    const std::size_t i = k % 2 == 0 ? k / 2 : n - 1 - k / 2;
+    for (std::size_t j = i + 1; j < n; ++j) {
+      absl::StatusOr<float> d = GlobalDistance(method, features[i], features[j]);
+      if (!d.ok()) {
+        errors[i] = d.status();
+        return;
+      }
+      distances[i * n + j] = distances[j * n + i] = *d;
+    }
+  });
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!errors[i].ok()) {
+      return absl::Status(errors[i].code(), absl::StrCat("model ", i, ": ", errors[i].message()));
+    }
+  }
+  return distances;
+}
+
 absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<ManifestEntry>& models,
                                                         const RetrievalPipelineOptions& options) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
@@ -213,18 +240,25 @@ absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<Manife
                           << " models have no local features; they are ranked last for every query";
   }
 
-  stage = std::chrono::steady_clock::now();
-  MESHSEEK_ASSIGN_OR_RETURN(const Codebook codebook, TrainCollectionCodebook(features, options));
-  result.codebook_size = codebook.size();
-  result.timings.codebook_seconds = SecondsSince(stage);
+  if (FeatureMethodInfoOf(options.extractor.method).kind == DescriptorKind::kGlobal) {
+    stage = std::chrono::steady_clock::now();
+    MESHSEEK_ASSIGN_OR_RETURN(result.distances, RankGlobalCollection(features, options));
+    result.timings.rank_seconds = SecondsSince(stage);
+  } else {
+    stage = std::chrono::steady_clock::now();
+    MESHSEEK_ASSIGN_OR_RETURN(const Codebook codebook, TrainCollectionCodebook(features, options));
+    result.codebook_size = codebook.size();
+    result.timings.codebook_seconds = SecondsSince(stage);
 
-  stage = std::chrono::steady_clock::now();
-  MESHSEEK_ASSIGN_OR_RETURN(const auto histograms, EncodeCollection(codebook, features, options));
-  result.timings.encode_seconds = SecondsSince(stage);
+    stage = std::chrono::steady_clock::now();
+    MESHSEEK_ASSIGN_OR_RETURN(const auto histograms,
+                              EncodeCollection(codebook, features, options));
+    result.timings.encode_seconds = SecondsSince(stage);
 
-  stage = std::chrono::steady_clock::now();
-  MESHSEEK_ASSIGN_OR_RETURN(result.distances, RankCollection(histograms, options));
-  result.timings.rank_seconds = SecondsSince(stage);
+    stage = std::chrono::steady_clock::now();
+    MESHSEEK_ASSIGN_OR_RETURN(result.distances, RankCollection(histograms, options));
+    result.timings.rank_seconds = SecondsSince(stage);
+  }
 
   std::vector<std::string> labels;
   labels.reserve(models.size());

@@ -81,6 +81,11 @@ absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
 absl::StatusOr<std::vector<float>> RankCollection(const std::vector<std::vector<float>>& histograms,
                                                   const RetrievalPipelineOptions& options);
 
+// All-pairs distances of a global method (FeatureMethodInfo::distance), N x N
+// row-major, each pair computed once, rows in parallel.
+absl::StatusOr<std::vector<float>> RankGlobalCollection(const std::vector<LocalFeatures>& features,
+                                                        const RetrievalPipelineOptions& options);
+
 struct StageTimings {
   double extract_seconds = 0;
   double codebook_seconds = 0;
@@ -99,7 +104,8 @@ struct CollectionEvaluation {
   StageTimings timings;
 };
 
-// Runs every stage on a labelled collection and evaluates the ranking.
+// Runs every stage on a labelled collection and evaluates the ranking; a
+// global method (DescriptorKind::kGlobal) skips the codebook and encoding.
 absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<ManifestEntry>& models,
                                                         const RetrievalPipelineOptions& options);
 

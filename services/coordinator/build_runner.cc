@@ -154,8 +154,12 @@ void BuildRunner::Run(const std::string& job_id, const std::string& collection) 
     }
     std::string().swap(m.features);
   }
-  // 1. The codebook, unless a resumed build trained it already.
-  if (absl::Status trained = Train(codebook_id, *info, features); !trained.ok()) {
+  // 1. The codebook, unless a resumed build trained it already or the method
+  // is global (then the id only names this generation of the index).
+  const bool global =
+      FeatureMethodInfoOf(info->options.extractor.method).kind == DescriptorKind::kGlobal;
+  if (absl::Status trained = global ? absl::OkStatus() : Train(codebook_id, *info, features);
+      !trained.ok()) {
     if (*stop_) return Done(collection);  // resumed after the restart
     return fail(Prefixed(trained, "codebook training: "));
   }
@@ -165,10 +169,10 @@ void BuildRunner::Run(const std::string& job_id, const std::string& collection) 
   ParallelFor(members->size(), options_.max_in_flight, [&](std::size_t i) {
     const ExtractedModel& m = (*members)[i];
     if (m.indexed_codebook == codebook_id || *stop_) return;
-    absl::StatusOr<v1::SparseHistogram> histogram = workers_->Encode(codebook_id, features[i]);
-    errors[i] = histogram.ok()
-                    ? workers_->AddToIndex(collection, m.model_id, m.ordinal, m.label, *histogram)
-                    : histogram.status();
+    absl::StatusOr<IndexSignature> signature = workers_->Encode(*info, codebook_id, features[i]);
+    errors[i] = signature.ok()
+                    ? workers_->AddToIndex(collection, m.model_id, m.ordinal, m.label, *signature)
+                    : signature.status();
     if (errors[i].ok()) errors[i] = store_->MarkIndexed({collection, m.model_id}, codebook_id);
   });
   if (*stop_) return Done(collection);  // resumed after the restart

@@ -269,11 +269,16 @@ grpc::Status CoordinatorService::Query(grpc::ServerContext*,
   rpc::MeshToProto(*mesh, &arrays);
   absl::StatusOr<v1::LocalFeatures> features = workers_.Extract(arrays, *info, "query");
   if (!features.ok()) return rpc::ToGrpcStatus(features.status());
-  absl::StatusOr<v1::SparseHistogram> histogram = workers_.Encode(info->codebook_id, *features);
-  if (!histogram.ok()) return rpc::ToGrpcStatus(histogram.status());
+  absl::StatusOr<IndexSignature> signature =
+      workers_.Encode(*info, info->codebook_id, *features);
+  if (!signature.ok()) return rpc::ToGrpcStatus(signature.status());
   v1::SearchRequest search;
   search.set_collection(request->collection());
-  *search.mutable_histogram() = *histogram;
+  if (signature->descriptor.has_value()) {
+    *search.mutable_global_descriptor() = *signature->descriptor;
+  } else {
+    *search.mutable_histogram() = signature->histogram;
+  }
   search.set_top_k(request->top_k());
   search.set_candidates(request->candidates());
   search.set_kl_epsilon(info->options.kl.epsilon);

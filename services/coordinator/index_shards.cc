@@ -146,7 +146,13 @@ absl::Status IndexShards::ForEachDistanceRow(const std::string& collection,
     v1::DistancesRequest request;
     request.set_collection(collection);
     request.set_kl_epsilon(kl_epsilon);
-    for (std::size_t i = begin; i < end; ++i) *request.add_queries() = models[i].histogram();
+    for (std::size_t i = begin; i < end; ++i) {
+      if (models[i].has_global_descriptor()) {
+        *request.add_global_queries() = models[i].global_descriptor();
+      } else {
+        *request.add_queries() = models[i].histogram();
+      }
+    }
     block.assign((end - begin) * n, -1.0f);
     std::size_t covered = 0;
     for (std::size_t s = 0; s < shards_.size(); ++s) {

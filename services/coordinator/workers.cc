@@ -56,28 +56,47 @@ absl::StatusOr<v1::LocalFeatures> Workers::Extract(const v1::Mesh& mesh,
   return std::move(*response.mutable_features());
 }
 
-absl::StatusOr<v1::SparseHistogram> Workers::Encode(const std::string& codebook_id,
-                                                    const v1::LocalFeatures& features) {
+absl::StatusOr<IndexSignature> Workers::Encode(const CollectionInfo& collection,
+                                               const std::string& codebook_id,
+                                               const v1::LocalFeatures& features) {
+  IndexSignature signature;
+  const FeatureMethod method = collection.options.extractor.method;
+  if (FeatureMethodInfoOf(method).kind == DescriptorKind::kGlobal) {
+    if (features.count() != 1 || features.descriptors().size() != features.dimension()) {
+      return absl::DataLossError(absl::StrCat("features of ", features.count(), " descriptors of ",
+                                              features.dimension(), " bytes, not one global ",
+                                              FeatureMethodName(method), " descriptor"));
+    }
+    signature.descriptor.emplace();
+    signature.descriptor->set_method(FeatureMethodName(method));
+    signature.descriptor->set_data(features.descriptors());
+    return signature;
+  }
   v1::EncodeRequest request;
   request.set_codebook_id(codebook_id);
   *request.mutable_features() = features;
   v1::EncodeResponse response;
   MESHSEEK_RETURN_IF_ERROR(rpc::CallWithRetry(codebook_.get(), &v1::Codebook::Stub::Encode, request,
                                               &response, options_.call_deadline, retry_, stop_));
-  return std::move(*response.mutable_histogram());
+  signature.histogram = std::move(*response.mutable_histogram());
+  return signature;
 }
 
 absl::Status Workers::AddToIndex(const std::string& collection,
                                  const std::string& model_id,
                                  uint64_t ordinal,
                                  const std::string& label,
-                                 const v1::SparseHistogram& histogram) {
+                                 const IndexSignature& signature) {
   v1::AddModelRequest request;
   request.set_collection(collection);
   request.set_model_id(model_id);
   request.set_ordinal(ordinal);
   request.set_label(label);
-  *request.mutable_histogram() = histogram;
+  if (signature.descriptor.has_value()) {
+    *request.mutable_global_descriptor() = *signature.descriptor;
+  } else {
+    *request.mutable_histogram() = signature.histogram;
+  }
   return index_->Add(request);
 }
 

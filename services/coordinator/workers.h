@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
@@ -34,6 +35,13 @@ struct CollectionInfo {
 /// longer validate.
 absl::StatusOr<CollectionInfo> LoadCollection(CoordinatorStore* store, const std::string& name);
 
+/// What the index ranks a model by: its histogram over a codebook (bag of
+/// features), or its descriptor (a global method: no codebook).
+struct IndexSignature {
+  v1::SparseHistogram histogram;
+  std::optional<v1::GlobalDescriptor> descriptor;
+};
+
 class Workers {
  public:
   /// `stop` (not owned) ends retries early when the coordinator stops.
@@ -43,13 +51,16 @@ class Workers {
   absl::StatusOr<v1::LocalFeatures> Extract(const v1::Mesh& mesh,
                                             const CollectionInfo& collection,
                                             const std::string& model_id);
-  absl::StatusOr<v1::SparseHistogram> Encode(const std::string& codebook_id,
-                                             const v1::LocalFeatures& features);
+  /// The signature of extracted features: encoded with `codebook_id` by the
+  /// codebook service, or, for a global method, the features' one descriptor.
+  absl::StatusOr<IndexSignature> Encode(const CollectionInfo& collection,
+                                        const std::string& codebook_id,
+                                        const v1::LocalFeatures& features);
   absl::Status AddToIndex(const std::string& collection,
                           const std::string& model_id,
                           uint64_t ordinal,
                           const std::string& label,
-                          const v1::SparseHistogram& histogram);
+                          const IndexSignature& signature);
 
   v1::Codebook::Stub* codebook() { return codebook_.get(); }
   IndexShards* index() { return index_.get(); }

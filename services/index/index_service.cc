@@ -17,6 +17,10 @@ grpc::Status InvalidArgument(const std::string& message) {
   return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, message);
 }
 
+absl::Span<const uint8_t> AsBytes(const std::string& data) {
+  return absl::MakeConstSpan(reinterpret_cast<const uint8_t*>(data.data()), data.size());
+}
+
 double EpsilonOrDefault(double epsilon) {
   return epsilon > 0 ? epsilon : KlDivergenceOptions().epsilon;
 }
@@ -39,6 +43,16 @@ absl::StatusOr<std::unique_ptr<IndexService>> IndexService::Create(
       "CREATE TABLE IF NOT EXISTS models (collection TEXT NOT NULL, model_id TEXT NOT NULL, "
       "ordinal INTEGER NOT NULL, label TEXT NOT NULL, histogram BLOB NOT NULL, "
       "PRIMARY KEY (collection, model_id))"));
+  // Global descriptors (serialised GlobalDescriptor; empty for a histogram),
+  // added to databases of the first release in place.
+  MESHSEEK_ASSIGN_OR_RETURN(
+      Statement has_descriptor,
+      db->Prepare("SELECT COUNT(*) FROM pragma_table_info('models') WHERE name = 'descriptor'"));
+  MESHSEEK_RETURN_IF_ERROR(has_descriptor.Step().status());
+  if (has_descriptor.ColumnInt(0) == 0) {
+    MESHSEEK_RETURN_IF_ERROR(
+        db->Execute("ALTER TABLE models ADD COLUMN descriptor BLOB NOT NULL DEFAULT x''"));
+  }
   std::unique_ptr<IndexService> service(new IndexService(options, std::move(db)));
   MESHSEEK_RETURN_IF_ERROR(service->Load());
   return service;
@@ -49,20 +63,25 @@ absl::Status IndexService::Load() {
   absl::MutexLock lock(&mutex_);
   MESHSEEK_ASSIGN_OR_RETURN(
       Statement select,
-      db_->Prepare("SELECT collection, model_id, ordinal, label, histogram FROM models"));
+      db_->Prepare(
+          "SELECT collection, model_id, ordinal, label, histogram, descriptor FROM models"));
   while (true) {
     MESHSEEK_ASSIGN_OR_RETURN(const bool row, select.Step());
     if (!row) break;
     const std::string model_id = select.ColumnText(1);
-    v1::SparseHistogram proto;
-    absl::StatusOr<SparseHistogram> histogram =
-        proto.ParseFromString(select.ColumnBlob(4))
-            ? rpc::SparseHistogramFromProto(proto, absl::StrCat("model '", model_id, "'"))
+    v1::SparseHistogram histogram;
+    v1::GlobalDescriptor descriptor;
+    const std::string descriptor_bytes = select.ColumnBlob(5);
+    absl::StatusOr<Signature> signature =
+        histogram.ParseFromString(select.ColumnBlob(4)) &&
+                descriptor.ParseFromString(descriptor_bytes)
+            ? ParseSignature(histogram, descriptor_bytes.empty() ? nullptr : &descriptor,
+                             absl::StrCat("model '", model_id, "'"))
             : absl::InvalidArgumentError("does not parse");
-    absl::Status placed = histogram.status();
+    absl::Status placed = signature.status();
     if (placed.ok()) {
       placed = Place(&collections_[select.ColumnText(0)], model_id,
-                     static_cast<uint64_t>(select.ColumnInt(2)), select.ColumnText(3), *histogram);
+                     static_cast<uint64_t>(select.ColumnInt(2)), select.ColumnText(3), *signature);
     }
     if (!placed.ok()) {
       return absl::DataLossError(absl::StrCat("index: stored histogram of model '", model_id,
@@ -73,27 +92,104 @@ absl::Status IndexService::Load() {
   return absl::OkStatus();
 }
 
+absl::StatusOr<IndexService::Signature> IndexService::ParseSignature(
+    const v1::SparseHistogram& histogram,
+    const v1::GlobalDescriptor* descriptor,
+    const std::string& what) {
+  Signature signature;
+  if (descriptor == nullptr) {
+    MESHSEEK_ASSIGN_OR_RETURN(signature.histogram, rpc::SparseHistogramFromProto(histogram, what));
+    return signature;
+  }
+  if (histogram.size() != 0 || histogram.bins_size() != 0) {
+    return absl::InvalidArgumentError(absl::StrCat(what, ": both a histogram and a descriptor"));
+  }
+  absl::StatusOr<FeatureMethod> method = ParseFeatureMethod(descriptor->method());
+  if (!method.ok() || FeatureMethodInfoOf(*method).kind != DescriptorKind::kGlobal) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        what, ": descriptor of '", descriptor->method(), "', which is not a global method"));
+  }
+  if (descriptor->data().empty() || descriptor->data().size() > kMaxDescriptorDimension) {
+    return absl::InvalidArgumentError(absl::StrCat(what, ": descriptor of ",
+                                                   descriptor->data().size(), " bytes, expected 1 to ",
+                                                   kMaxDescriptorDimension));
+  }
+  signature.descriptor = *descriptor;
+  return signature;
+}
+
+absl::Status IndexService::CheckFits(const Collection& collection,
+                                     const std::string& model_id,
+                                     const Signature& signature) {
+  if (collection.docs.empty() ||
+      (collection.docs.size() == 1 && collection.docs.contains(model_id))) {
+    return absl::OkStatus();  // the first model (or the only one, replacing itself) decides
+  }
+  if (signature.descriptor.has_value()) {
+    if (!collection.global.has_value()) {
+      return absl::InvalidArgumentError("a descriptor, but the collection holds histograms");
+    }
+    const std::string& method = signature.descriptor->method();
+    if (method != FeatureMethodName(collection.global->method()) ||
+        signature.descriptor->data().size() != collection.global->dimension()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "a ", method, " descriptor of ", signature.descriptor->data().size(),
+          " bytes, but the collection holds ", FeatureMethodName(collection.global->method()),
+          " descriptors of ", collection.global->dimension()));
+    }
+    return absl::OkStatus();
+  }
+  if (collection.global.has_value()) {
+    return absl::InvalidArgumentError("a histogram, but the collection holds global descriptors");
+  }
+  if (collection.engine->vocabulary() != signature.histogram.vocabulary) {
+    return absl::InvalidArgumentError(absl::StrCat("histogram of size ",
+                                                   signature.histogram.vocabulary,
+                                                   " but the collection holds size ",
+                                                   collection.engine->vocabulary()));
+  }
+  return absl::OkStatus();
+}
+
 absl::Status IndexService::Place(Collection* collection,
                                  const std::string& model_id,
                                  uint64_t ordinal,
                                  const std::string& label,
-                                 const SparseHistogram& histogram) {
+                                 const Signature& signature) {
+  MESHSEEK_RETURN_IF_ERROR(CheckFits(*collection, model_id, signature));
+  const bool fresh = collection->docs.empty() || (collection->docs.size() == 1 &&
+                                                  collection->docs.contains(model_id));
+  if (signature.descriptor.has_value()) {
+    const std::string& data = signature.descriptor->data();
+    if (fresh || !collection->global.has_value()) {
+      MESHSEEK_ASSIGN_OR_RETURN(const FeatureMethod method,
+                                ParseFeatureMethod(signature.descriptor->method()));
+      MESHSEEK_ASSIGN_OR_RETURN(GlobalDescriptorIndex global,
+                                GlobalDescriptorIndex::Create(method, data.size()));
+      collection->global = std::move(global);
+      collection->engine.reset();
+      collection->docs.clear();
+      collection->models.clear();
+    }
+    auto [it, inserted] = collection->docs.try_emplace(model_id, collection->next_doc);
+    if (inserted) ++collection->next_doc;
+    MESHSEEK_RETURN_IF_ERROR(collection->global->Upsert(
+        it->second, absl::MakeConstSpan(reinterpret_cast<const uint8_t*>(data.data()), data.size())));
+    collection->models[it->second] = Model{model_id, ordinal, label};
+    return absl::OkStatus();
+  }
+  const SparseHistogram& histogram = signature.histogram;
   if (!collection->engine.has_value() ||
-      (collection->engine->vocabulary() != histogram.vocabulary && collection->docs.size() == 1 &&
-       collection->docs.contains(model_id))) {
+      (fresh && collection->engine->vocabulary() != histogram.vocabulary)) {
     // The first model fixes the vocabulary (or the only one replaces itself).
     KlDivergenceOptions kl;
     if (collection->engine.has_value()) kl = collection->engine->options();
     MESHSEEK_ASSIGN_OR_RETURN(KlInvertedIndex engine,
                               KlInvertedIndex::Create(histogram.vocabulary, kl));
     collection->engine = std::move(engine);
+    collection->global.reset();
     collection->docs.clear();
     collection->models.clear();
-  }
-  if (collection->engine->vocabulary() != histogram.vocabulary) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("histogram of size ", histogram.vocabulary, " but the collection holds size ",
-                     collection->engine->vocabulary()));
   }
   auto [it, inserted] = collection->docs.try_emplace(model_id, collection->next_doc);
   if (inserted) ++collection->next_doc;
@@ -109,37 +205,40 @@ grpc::Status IndexService::AddModel(grpc::ServerContext*,
     return InvalidArgument("add: collection and model_id must not be empty");
   }
   const std::string name = absl::StrCat("add model '", request->model_id(), "'");
-  absl::StatusOr<SparseHistogram> histogram =
-      rpc::SparseHistogramFromProto(request->histogram(), name);
-  if (!histogram.ok()) return rpc::ToGrpcStatus(histogram.status());
+  absl::StatusOr<Signature> signature = ParseSignature(
+      request->histogram(), request->has_global_descriptor() ? &request->global_descriptor() : nullptr, name);
+  if (!signature.ok()) return rpc::ToGrpcStatus(signature.status());
   absl::MutexLock write(&write_mutex_);
   {
     // Refuse what Place would refuse before anything is written.
     absl::ReaderMutexLock lock(&mutex_);
     auto it = collections_.find(request->collection());
-    if (it != collections_.end() && it->second.engine.has_value() &&
-        it->second.engine->vocabulary() != histogram->vocabulary &&
-        !(it->second.docs.size() == 1 && it->second.docs.contains(request->model_id()))) {
-      return InvalidArgument(absl::StrCat(name, ": histogram of size ", histogram->vocabulary,
-                                          " but collection '", request->collection(),
-                                          "' holds size ", it->second.engine->vocabulary()));
+    if (it != collections_.end()) {
+      if (absl::Status fits = CheckFits(it->second, request->model_id(), *signature); !fits.ok()) {
+        return InvalidArgument(
+            absl::StrCat(name, " to collection '", request->collection(), "': ", fits.message()));
+      }
     }
   }
   absl::StatusOr<Statement> upsert = db_->Prepare(
-      "INSERT OR REPLACE INTO models (collection, model_id, ordinal, label, histogram) "
-      "VALUES (?, ?, ?, ?, ?)");
-  absl::Status stored = upsert.ok() ? upsert->Bind(1, request->collection())
-                                          .Bind(2, request->model_id())
-                                          .Bind(3, static_cast<int64_t>(request->ordinal()))
-                                          .Bind(4, request->label())
-                                          .BindBlob(5, request->histogram().SerializeAsString())
-                                          .Run()
-                                    : upsert.status();
+      "INSERT OR REPLACE INTO models (collection, model_id, ordinal, label, histogram, "
+      "descriptor) VALUES (?, ?, ?, ?, ?, ?)");
+  absl::Status stored =
+      upsert.ok() ? upsert->Bind(1, request->collection())
+                        .Bind(2, request->model_id())
+                        .Bind(3, static_cast<int64_t>(request->ordinal()))
+                        .Bind(4, request->label())
+                        .BindBlob(5, request->histogram().SerializeAsString())
+                        .BindBlob(6, request->has_global_descriptor()
+                                         ? request->global_descriptor().SerializeAsString()
+                                         : std::string())
+                        .Run()
+                  : upsert.status();
   if (!stored.ok()) return rpc::ToGrpcStatus(stored);
   absl::MutexLock lock(&mutex_);
   Collection& collection = collections_[request->collection()];
   const absl::Status placed = Place(&collection, request->model_id(), request->ordinal(),
-                                    request->label(), *histogram);
+                                    request->label(), *signature);
   if (!placed.ok()) return rpc::ToGrpcStatus(placed);  // checked above: not reached
   response->set_collection_size(collection.docs.size());
   return grpc::Status::OK;
@@ -162,7 +261,11 @@ grpc::Status IndexService::RemoveModel(grpc::ServerContext*,
     Collection& collection = it->second;
     auto doc = collection.docs.find(request->model_id());
     if (doc != collection.docs.end()) {
-      collection.engine->Remove(doc->second);
+      if (collection.global.has_value()) {
+        collection.global->Remove(doc->second);
+      } else {
+        collection.engine->Remove(doc->second);
+      }
       collection.models.erase(doc->second);
       collection.docs.erase(doc);
       removed = true;
@@ -204,6 +307,7 @@ absl::StatusOr<const IndexService::Collection*> IndexService::FindCollection(
   if (it == collections_.end() || it->second.docs.empty()) {
     return absl::NotFoundError(absl::StrCat("index has no models in collection '", name, "'"));
   }
+  if (it->second.global.has_value()) return &it->second;  // no epsilon
   if (it->second.engine->options().epsilon != EpsilonOrDefault(epsilon)) {
     return absl::AbortedError(absl::StrCat("collection '", name, "' is ranked with KL epsilon ",
                                            it->second.engine->options().epsilon,
@@ -228,18 +332,26 @@ grpc::Status IndexService::Search(grpc::ServerContext*,
                                   const v1::SearchRequest* request,
                                   v1::SearchResponse* response) {
   if (request->top_k() == 0) return InvalidArgument("search: top_k must be at least 1");
-  absl::StatusOr<SparseHistogram> query =
-      rpc::SparseHistogramFromProto(request->histogram(), "search: query histogram");
+  absl::StatusOr<Signature> query =
+      ParseSignature(request->histogram(),
+                     request->has_global_descriptor() ? &request->global_descriptor() : nullptr, "search: query");
   if (!query.ok()) return rpc::ToGrpcStatus(query.status());
-  UseEpsilon(request->collection(), request->kl_epsilon());
+  if (!query->descriptor.has_value()) UseEpsilon(request->collection(), request->kl_epsilon());
   absl::ReaderMutexLock lock(&mutex_);
   absl::StatusOr<const Collection*> collection =
       FindCollection(request->collection(), request->kl_epsilon());
   if (!collection.ok()) return rpc::ToGrpcStatus(collection.status());
+  if (absl::Status fits = CheckFits(**collection, "", *query); !fits.ok()) {
+    return InvalidArgument(absl::StrCat("search '", request->collection(), "': ", fits.message()));
+  }
   const std::size_t candidates =
       request->candidates() == 0 ? 0 : std::max(request->candidates(), request->top_k());
   absl::StatusOr<std::vector<KlNeighbor>> found =
-      (*collection)->engine->Search(*query, request->top_k(), options_.num_threads, candidates);
+      query->descriptor.has_value()
+          ? (*collection)->global->Search(AsBytes(query->descriptor->data()), request->top_k(),
+                                          options_.num_threads)
+          : (*collection)->engine->Search(query->histogram, request->top_k(),
+                                          options_.num_threads, candidates);
   if (!found.ok()) return rpc::ToGrpcStatus(found.status());
   // The engine breaks ties by doc and returns every model tied with the k-th:
   // rank ties by ordinal (then id) as the whole collection would be.
@@ -284,14 +396,26 @@ grpc::Status IndexService::ExportModels(grpc::ServerContext* context,
     absl::flat_hash_map<uint32_t, std::size_t> position;
     for (std::size_t i = 0; i < docs.size(); ++i) position[docs[i]] = i;
     models.resize(docs.size());
-    collection.engine->ForEach([&](uint32_t doc, const SparseHistogram& histogram) {
+    auto describe = [&](uint32_t doc) -> v1::IndexedModel& {
       v1::IndexedModel& out = models[position.at(doc)];
       const Model& model = collection.models.at(doc);
       out.set_model_id(model.model_id);
       out.set_ordinal(model.ordinal);
       out.set_label(model.label);
-      rpc::SparseHistogramToProto(histogram, out.mutable_histogram());
-    });
+      return out;
+    };
+    if (collection.global.has_value()) {
+      const char* method = FeatureMethodName(collection.global->method());
+      collection.global->ForEach([&](uint32_t doc, absl::Span<const uint8_t> bytes) {
+        v1::GlobalDescriptor* d = describe(doc).mutable_global_descriptor();
+        d->set_method(method);
+        d->set_data(bytes.data(), bytes.size());
+      });
+    } else {
+      collection.engine->ForEach([&](uint32_t doc, const SparseHistogram& histogram) {
+        rpc::SparseHistogramToProto(histogram, describe(doc).mutable_histogram());
+      });
+    }
   }
   for (const v1::IndexedModel& model : models) {
     if (context->IsCancelled() || !writer->Write(model)) return grpc::Status::CANCELLED;
@@ -302,23 +426,42 @@ grpc::Status IndexService::ExportModels(grpc::ServerContext* context,
 grpc::Status IndexService::Distances(grpc::ServerContext*,
                                      const v1::DistancesRequest* request,
                                      v1::DistancesResponse* response) {
-  if (request->queries_size() > kMaxDistanceQueries) {
-    return InvalidArgument(absl::StrCat("distances: ", request->queries_size(),
-                                        " queries, at most ", kMaxDistanceQueries, " per request"));
+  const int total = request->queries_size() + request->global_queries_size();
+  if (total > kMaxDistanceQueries) {
+    return InvalidArgument(absl::StrCat("distances: ", total, " queries, at most ",
+                                        kMaxDistanceQueries, " per request"));
   }
-  std::vector<SparseHistogram> queries;
+  if (request->queries_size() > 0 && request->global_queries_size() > 0) {
+    return InvalidArgument("distances: both histogram and descriptor queries");
+  }
+  std::vector<Signature> queries;
   for (int q = 0; q < request->queries_size(); ++q) {
-    absl::StatusOr<SparseHistogram> query =
-        rpc::SparseHistogramFromProto(request->queries(q), absl::StrCat("distances: query ", q));
+    absl::StatusOr<Signature> query =
+        ParseSignature(request->queries(q), nullptr, absl::StrCat("distances: query ", q));
     if (!query.ok()) return rpc::ToGrpcStatus(query.status());
     queries.push_back(*std::move(query));
   }
-  UseEpsilon(request->collection(), request->kl_epsilon());
+  for (int q = 0; q < request->global_queries_size(); ++q) {
+    absl::StatusOr<Signature> query =
+        ParseSignature(v1::SparseHistogram(), &request->global_queries(q),
+                       absl::StrCat("distances: query ", q));
+    if (!query.ok()) return rpc::ToGrpcStatus(query.status());
+    queries.push_back(*std::move(query));
+  }
+  if (request->queries_size() > 0) UseEpsilon(request->collection(), request->kl_epsilon());
   absl::ReaderMutexLock lock(&mutex_);
   absl::StatusOr<const Collection*> found =
       FindCollection(request->collection(), request->kl_epsilon());
   if (!found.ok()) return rpc::ToGrpcStatus(found.status());
   const Collection& collection = **found;
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    // An empty histogram (a model without features) is every model's
+    // stranger, whatever the vocabulary.
+    if (!queries[q].descriptor.has_value() && queries[q].histogram.words.empty()) continue;
+    if (absl::Status fits = CheckFits(collection, "", queries[q]); !fits.ok()) {
+      return InvalidArgument(absl::StrCat("distances: query ", q, ": ", fits.message()));
+    }
+  }
   const std::vector<uint32_t> docs = DocsInOrder(collection);
   absl::flat_hash_map<uint32_t, std::size_t> column;
   for (std::size_t i = 0; i < docs.size(); ++i) {
@@ -332,7 +475,10 @@ grpc::Status IndexService::Distances(grpc::ServerContext*,
   float* out = response->mutable_distances()->mutable_data();
   std::vector<absl::Status> errors(queries.size());
   ParallelFor(queries.size(), options_.num_threads, [&](std::size_t q) {
-    absl::StatusOr<std::vector<KlNeighbor>> row = collection.engine->Distances(queries[q], 1);
+    absl::StatusOr<std::vector<KlNeighbor>> row =
+        queries[q].descriptor.has_value()
+            ? collection.global->Distances(AsBytes(queries[q].descriptor->data()), 1)
+            : collection.engine->Distances(queries[q].histogram, 1);
     if (!row.ok()) {
       errors[q] = row.status();
       return;
@@ -362,6 +508,7 @@ std::size_t IndexService::MemoryBytes() {
   std::size_t bytes = 0;
   for (const auto& [name, collection] : collections_) {
     if (collection.engine.has_value()) bytes += collection.engine->MemoryBytes();
+    if (collection.global.has_value()) bytes += collection.global->MemoryBytes();
   }
   return bytes;
 }

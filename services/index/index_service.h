@@ -2,7 +2,10 @@
 // bag-of-features histogram, ranked by exact symmetric KL divergence through
 // an inverted file (common/search/kl_inverted_index.h): sparse storage, no
 // copy of the collection per query, and queries in parallel with each other
-// under a reader lock.
+// under a reader lock. A collection of a global method (LFD) holds each
+// model's descriptor instead, ranked by the method's distance
+// (common/search/global_descriptor_index.h); the first model added fixes the
+// collection's kind.
 //
 // Every add and remove is written to SQLite (WAL) before it is answered, and
 // the whole index is loaded into memory at start, so a kill -9 and restart
@@ -25,6 +28,7 @@
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
+#include "common/search/global_descriptor_index.h"
 #include "common/search/kl_inverted_index.h"
 #include "common/store/sqlite_db.h"
 #include "meshseek/v1/index.grpc.pb.h"
@@ -83,7 +87,24 @@ class IndexService final : public v1::Index::Service {
     // Created by the first add, with its vocabulary and the default epsilon;
     // rebuilt when a request asks for another epsilon.
     std::optional<KlInvertedIndex> engine;
+    // Instead of `engine`, for a collection of a global method.
+    std::optional<GlobalDescriptorIndex> global;
   };
+  // What one model is ranked by: a histogram, or a global descriptor.
+  struct Signature {
+    SparseHistogram histogram;
+    std::optional<v1::GlobalDescriptor> descriptor;
+  };
+  // The signature of a request (AddModel, Search, a Distances query),
+  // checked: InvalidArgument naming `what`.
+  static absl::StatusOr<Signature> ParseSignature(const v1::SparseHistogram& histogram,
+                                                  const v1::GlobalDescriptor* descriptor,
+                                                  const std::string& what);
+  // Why `signature` cannot join `collection` (another kind, vocabulary,
+  // method or size), or OK. `model_id` may replace the only model.
+  static absl::Status CheckFits(const Collection& collection,
+                                const std::string& model_id,
+                                const Signature& signature);
 
   IndexService(const IndexServiceOptions& options, std::unique_ptr<Database> db)
       : options_(options), db_(std::move(db)) {}
@@ -94,7 +115,7 @@ class IndexService final : public v1::Index::Service {
                      const std::string& model_id,
                      uint64_t ordinal,
                      const std::string& label,
-                     const SparseHistogram& histogram) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+                     const Signature& signature) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // Makes the engine of collection `name` use `epsilon` (0: the default),
   // rebuilding it under the writer lock when it uses another (collections keep
   // one epsilon, so this happens once, if ever).
