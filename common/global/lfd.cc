@@ -18,8 +18,16 @@
 namespace meshseek {
 namespace {
 
-// View-to-view L1 distances, row a-view, column b-view: 48 x 255 < 65,536.
-using ViewTable = std::array<uint16_t, kLfdViews * kLfdViews>;
+// View-to-view L1 distances (at most 48 x 255 = 12,240: int16). Row i is
+// a-view i; within it the b-view j = 10 lb + k (light field lb, view k) is
+// at column 10 k + lb, so that the ten b light fields sit side by side and
+// a rotation's sums for all ten are one pass of vector additions
+// (MinimumScalar, MinimumAvx2).
+// Padded by 6 entries: the vector kernel reads 16 lanes where 10 are used.
+using ViewTable = std::array<int16_t, kLfdViews * kLfdViews + 6>;
+constexpr int Column(int j) {
+  return (j % kLfdViewsPerLightField) * kLfdLightFields + j / kLfdViewsPerLightField;
+}
 
 void ViewTableScalar(const uint8_t* a, const uint8_t* b, ViewTable* table) {
   for (int i = 0; i < kLfdViews; ++i) {
@@ -29,7 +37,7 @@ void ViewTableScalar(const uint8_t* a, const uint8_t* b, ViewTable* table) {
       int sum = 0;
       // All 48 bytes, padding included, as the SIMD kernel does.
       for (int k = 0; k < kLfdViewStride; ++k) sum += std::abs(int{va[k]} - int{vb[k]});
-      (*table)[i * kLfdViews + j] = static_cast<uint16_t>(sum);
+      (*table)[i * kLfdViews + Column(j)] = static_cast<int16_t>(sum);
     }
   }
 }
@@ -43,21 +51,22 @@ __attribute__((target("avx2"))) void ViewTableAvx2(const uint8_t* a, const uint8
     const uint8_t* va = a + i * kLfdViewStride;
     const __m256i a0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(va));
     const __m128i a1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(va + 32));
-    uint16_t* row = table->data() + i * kLfdViews;
+    int16_t* row = table->data() + i * kLfdViews;
     for (int j = 0; j < kLfdViews; ++j) {
       const uint8_t* vb = b + j * kLfdViewStride;
       const __m256i s = _mm256_sad_epu8(a0, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(vb)));
       const __m128i t = _mm_sad_epu8(a1, _mm_loadu_si128(reinterpret_cast<const __m128i*>(vb + 32)));
       const __m128i u =
           _mm_add_epi64(_mm_add_epi64(_mm256_castsi256_si128(s), _mm256_extracti128_si256(s, 1)), t);
-      row[j] = static_cast<uint16_t>(_mm_cvtsi128_si32(u) + _mm_extract_epi32(u, 2));
+      row[Column(j)] = static_cast<int16_t>(_mm_cvtsi128_si32(u) + _mm_extract_epi32(u, 2));
     }
   }
 }
 #endif
 
-// offsets[p][i]: where, inside the 10 x 10 block of a light-field pair,
-// rotation p finds the distance of a-view i to its b-view perm_p(i).
+// offsets[p][i]: where, from the entry of a-view 10 la and b-view 10 lb,
+// rotation p finds the distance of a-view 10 la + i to b-view
+// 10 lb + perm_p(i).
 struct PermutationOffsets {
   std::array<std::array<uint16_t, kLfdViewsPerLightField>, kLfdCameraRotations> offsets;
 };
@@ -68,7 +77,7 @@ const PermutationOffsets& Offsets() {
     const std::vector<ViewPermutation>& perms = ViewPermutations();
     for (int p = 0; p < kLfdCameraRotations; ++p) {
       for (int i = 0; i < kLfdViewsPerLightField; ++i) {
-        t.offsets[p][i] = static_cast<uint16_t>(i * kLfdViews + perms[p][i]);
+        t.offsets[p][i] = static_cast<uint16_t>(i * kLfdViews + Column(perms[p][i]));
       }
     }
     return t;
@@ -76,23 +85,52 @@ const PermutationOffsets& Offsets() {
   return table;
 }
 
-float DistanceFromTable(const ViewTable& table) {
+// The minimum over light-field pairs (la, lb) and rotations p of
+// sum_i table[a-view 10 la + i][b-view 10 lb + perm_p(i)]. For fixed la, p
+// and i the ten lb are ten adjacent entries (the layout above), so one pass
+// over (la, p, i) sums all ten b light fields at once, in vector lanes.
+int MinimumScalar(const ViewTable& table) {
   const PermutationOffsets& o = Offsets();
   int best = std::numeric_limits<int>::max();
   for (int la = 0; la < kLfdLightFields; ++la) {
-    for (int lb = 0; lb < kLfdLightFields; ++lb) {
-      const uint16_t* block = table.data() + la * kLfdViewsPerLightField * kLfdViews +
-                              lb * kLfdViewsPerLightField;
-      for (int p = 0; p < kLfdCameraRotations; ++p) {
-        const auto& off = o.offsets[p];
-        int sum = 0;
-        for (int i = 0; i < kLfdViewsPerLightField; ++i) sum += block[off[i]];
-        best = std::min(best, sum);
+    const int16_t* base = table.data() + la * kLfdViewsPerLightField * kLfdViews;
+    for (int p = 0; p < kLfdCameraRotations; ++p) {
+      int sum[kLfdLightFields] = {};
+      for (int i = 0; i < kLfdViewsPerLightField; ++i) {
+        const int16_t* entries = base + o.offsets[p][i];
+        for (int lb = 0; lb < kLfdLightFields; ++lb) sum[lb] += entries[lb];
       }
+      best = std::min(best, *std::min_element(sum, sum + kLfdLightFields));
     }
   }
-  return static_cast<float>(best);
+  return best;
 }
+
+#if defined(MESHSEEK_LFD_HAVE_AVX2_KERNEL)
+// The same with 16 unsigned 16-bit lanes (10 used), adding with saturation
+// at 65,535: the minimum is exact whenever it is below that, and otherwise
+// (descriptors almost nothing alike) the exact scalar code decides, so both
+// paths return the same integer.
+__attribute__((target("avx2"))) int MinimumAvx2(const ViewTable& table) {
+  const PermutationOffsets& o = Offsets();
+  __m256i best = _mm256_set1_epi16(-1);
+  for (int la = 0; la < kLfdLightFields; ++la) {
+    const int16_t* base = table.data() + la * kLfdViewsPerLightField * kLfdViews;
+    for (int p = 0; p < kLfdCameraRotations; ++p) {
+      const auto& off = o.offsets[p];
+      __m256i sum = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(base + off[0]));
+      for (int i = 1; i < kLfdViewsPerLightField; ++i) {
+        sum = _mm256_adds_epu16(sum, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(base + off[i])));
+      }
+      best = _mm256_min_epu16(best, sum);
+    }
+  }
+  alignas(32) uint16_t lanes[16];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(lanes), best);
+  const int m = *std::min_element(lanes, lanes + kLfdLightFields);
+  return m < 65535 ? m : MinimumScalar(table);
+}
+#endif
 
 bool UseAvx2(SimdLevel level) {
 #if defined(MESHSEEK_LFD_HAVE_AVX2_KERNEL)
@@ -198,15 +236,16 @@ namespace internal {
 
 float LfdDistanceAtLevel(const uint8_t* a, const uint8_t* b, SimdLevel level) {
   ViewTable table;
+  std::fill(table.begin() + kLfdViews * kLfdViews, table.end(), int16_t{0});
 #if defined(MESHSEEK_LFD_HAVE_AVX2_KERNEL)
   if (UseAvx2(level)) {
     ViewTableAvx2(a, b, &table);
-    return DistanceFromTable(table);
+    return static_cast<float>(MinimumAvx2(table));
   }
 #endif
   (void)level;
   ViewTableScalar(a, b, &table);
-  return DistanceFromTable(table);
+  return static_cast<float>(MinimumScalar(table));
 }
 
 }  // namespace internal

@@ -150,6 +150,14 @@ TEST(LfdDistanceTest, ScalarAndAvx2PathsAgreeBitForBit) {
   }
   descriptors.push_back(Extract(Box(1, 1, 1)));
   descriptors.push_back(Extract(Sphere(1)));
+  // Nothing alike: 10 views x 45 x 255 = 114,750, past the vector kernel's
+  // 16-bit sums, so the exact fallback decides.
+  std::vector<uint8_t> full(kLfdDescriptorBytes, 0), empty(kLfdDescriptorBytes, 0);
+  for (int v = 0; v < kLfdViews; ++v) std::fill_n(full.begin() + v * kLfdViewStride, kLfdCoefficientsPerView, 255);
+  EXPECT_EQ(internal::LfdDistanceAtLevel(full.data(), empty.data(), SimdLevel::kAvx2), 114750.0f);
+  EXPECT_EQ(internal::LfdDistanceAtLevel(full.data(), empty.data(), SimdLevel::kSse2), 114750.0f);
+  descriptors.push_back(full);
+  descriptors.push_back(empty);
   for (const auto& a : descriptors) {
     for (const auto& b : descriptors) {
       EXPECT_EQ(internal::LfdDistanceAtLevel(a.data(), b.data(), SimdLevel::kSse2),
