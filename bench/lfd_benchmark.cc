@@ -83,7 +83,9 @@ void BM_ExtractLfd(benchmark::State& state) {
       const double cpu_start = ThreadCpuMs();
       auto d = ExtractLfd(mesh, options);
       cpu.push_back(ThreadCpuMs() - cpu_start);
-      wall.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+      wall.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count());
       if (!d.ok()) {
         state.SkipWithError(std::string(d.status().message()).c_str());
         return;

@@ -33,7 +33,9 @@
 ABSL_FLAG(std::string, manifest, "", "CSV manifest id,class,path");
 ABSL_FLAG(int, threads, 2, "threads for extraction and the all-pairs matrix (<= 0: all cores)");
 ABSL_FLAG(int, image_size, meshseek::LfdOptions().image_size, "silhouette side in pixels");
-ABSL_FLAG(int, contour_samples, meshseek::LfdOptions().contour_samples,
+ABSL_FLAG(int,
+          contour_samples,
+          meshseek::LfdOptions().contour_samples,
           "contour points for the Fourier descriptor");
 ABSL_FLAG(std::string, distances_out, "", "write the N x N float32 distance matrix here");
 ABSL_FLAG(std::string, descriptors_out, "", "write the N descriptors here (raw bytes)");
@@ -107,8 +109,13 @@ int Run() {
   for (std::size_t i = 0; i < n; ++i) {
     if (!errors[i].ok()) {
       const ManifestEntry& m = (*models)[i];
-      std::fprintf(stderr, "%s:%d: model %s (%s): %s\n", manifest.c_str(), m.line, m.id.c_str(),
-                   m.path.c_str(), errors[i].ToString().c_str());
+      std::fprintf(stderr,
+                   "%s:%d: model %s (%s): %s\n",
+                   manifest.c_str(),
+                   m.line,
+                   m.id.c_str(),
+                   m.path.c_str(),
+                   errors[i].ToString().c_str());
       return 1;
     }
   }
@@ -151,16 +158,32 @@ int Run() {
   double total_cpu = 0;
   for (double s : cpu_s) total_cpu += s;
   std::printf("%s: %zu models, LFD image_size %d, contour_samples %d, %d threads, SIMD %s\n",
-              manifest.c_str(), n, options.image_size, options.contour_samples, threads,
+              manifest.c_str(),
+              n,
+              options.image_size,
+              options.contour_samples,
+              threads,
               SimdLevelName(DetectedSimdLevel()));
   std::printf("%s", FormatMetricsTable(*metrics).c_str());
-  std::printf("timings: read meshes %.1f s; extraction per model (one core, thread CPU) median %.0f ms, "
-              "p90 %.0f ms, max %.0f ms, total %.1f CPU s, %.1f s wall on %d threads; "
-              "all-pairs %zu x %zu (%zu distances) %.2f s wall on %d threads, %.2f CPU s "
-              "(%.1f us CPU per distance)\n",
-              read_s, 1e3 * sorted[n / 2], 1e3 * sorted[n * 9 / 10], 1e3 * sorted.back(), total_cpu,
-              extract_s, threads, n, n, n * (n - 1) / 2, matrix_s, threads, matrix_cpu_s,
-              1e6 * matrix_cpu_s / std::max<std::size_t>(1, n * (n - 1) / 2));
+  std::printf(
+      "timings: read meshes %.1f s; extraction per model (one core, thread CPU) median %.0f ms, "
+      "p90 %.0f ms, max %.0f ms, total %.1f CPU s, %.1f s wall on %d threads; "
+      "all-pairs %zu x %zu (%zu distances) %.2f s wall on %d threads, %.2f CPU s "
+      "(%.1f us CPU per distance)\n",
+      read_s,
+      1e3 * sorted[n / 2],
+      1e3 * sorted[n * 9 / 10],
+      1e3 * sorted.back(),
+      total_cpu,
+      extract_s,
+      threads,
+      n,
+      n,
+      n * (n - 1) / 2,
+      matrix_s,
+      threads,
+      matrix_cpu_s,
+      1e6 * matrix_cpu_s / std::max<std::size_t>(1, n * (n - 1) / 2));
   return 0;
 }
 

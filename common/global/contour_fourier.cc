@@ -17,13 +17,16 @@ absl::Status ContourFourierOptions::Validate() const {
   if (samples < 2 * kFourierCoefficients + 1 || samples > 65536) {
     return absl::InvalidArgumentError(absl::StrCat("contour fourier: samples must be in [",
                                                    2 * kFourierCoefficients + 1,
-                                                   ", 65536], got ", samples));
+                                                   ", 65536], got ",
+                                                   samples));
   }
   return absl::OkStatus();
 }
 
 absl::StatusOr<std::array<double, kFourierCoefficients>> CentroidDistanceFourier(
-    const std::vector<Point2d>& contour, const Point2d& centre, const ContourFourierOptions& options) {
+    const std::vector<Point2d>& contour,
+    const Point2d& centre,
+    const ContourFourierOptions& options) {
   if (absl::Status valid = options.Validate(); !valid.ok()) return valid;
   std::array<double, kFourierCoefficients> out{};
   const std::size_t n = contour.size();

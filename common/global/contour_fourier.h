@@ -57,7 +57,9 @@ struct ContourFourierOptions {
 /// points, or a contour of zero length or whose points all lie on the
 /// centre, give all zeros (nothing to describe; never NaN).
 absl::StatusOr<std::array<double, kFourierCoefficients>> CentroidDistanceFourier(
-    const std::vector<Point2d>& contour, const Point2d& centre, const ContourFourierOptions& options);
+    const std::vector<Point2d>& contour,
+    const Point2d& centre,
+    const ContourFourierOptions& options);
 
 /// The outer contour of the largest piece of the silhouette (OpenCV
 /// findContours, pixel-centre coordinates: pixel (x, y) at (x + 0.5, y + 0.5)).

@@ -67,15 +67,16 @@ TEST(CentroidDistanceFourierTest, CircleHasNoHarmonicsAndEllipseAnEvenOne) {
   const auto c = *CentroidDistanceFourier(circle, {0, 0}, {});
   for (double v : c) EXPECT_NEAR(v, 0.0, 1e-9);
   const auto e = *CentroidDistanceFourier(ellipse, {0, 0}, {});
-  EXPECT_GT(e[1], 0.1);           // k = 2: twice per turn
-  EXPECT_NEAR(e[0], 0.0, 1e-9);   // odd harmonics vanish by symmetry
+  EXPECT_GT(e[1], 0.1);          // k = 2: twice per turn
+  EXPECT_NEAR(e[0], 0.0, 1e-9);  // odd harmonics vanish by symmetry
   EXPECT_NEAR(e[2], 0.0, 1e-9);
 }
 
 TEST(CentroidDistanceFourierTest, DegenerateContoursGiveZeros) {
-  for (const std::vector<Point2d>& contour :
-       {std::vector<Point2d>{}, std::vector<Point2d>{{1, 1}, {2, 2}},
-        std::vector<Point2d>{{1, 1}, {1, 1}, {1, 1}}, std::vector<Point2d>{{0, 0}, {0, 0}, {0, 0}}}) {
+  for (const std::vector<Point2d>& contour : {std::vector<Point2d>{},
+                                              std::vector<Point2d>{{1, 1}, {2, 2}},
+                                              std::vector<Point2d>{{1, 1}, {1, 1}, {1, 1}},
+                                              std::vector<Point2d>{{0, 0}, {0, 0}, {0, 0}}}) {
     auto f = CentroidDistanceFourier(contour, {0, 0}, {});
     ASSERT_TRUE(f.ok());
     for (double v : *f) EXPECT_EQ(v, 0.0);
@@ -88,7 +89,8 @@ TEST(SilhouetteFourierTest, RasterisedRotatedPolygonsAgree) {
     cv::Mat m(n, n, CV_8U, cv::Scalar(0));
     std::vector<cv::Point> pts;
     for (const Point2d& p : Star(angle, scale, {n / 2.0, n / 2.0}, 0)) {
-      pts.emplace_back(static_cast<int>(std::lround(p.x * 256)), static_cast<int>(std::lround(p.y * 256)));
+      pts.emplace_back(static_cast<int>(std::lround(p.x * 256)),
+                       static_cast<int>(std::lround(p.y * 256)));
     }
     cv::fillPoly(m, std::vector<std::vector<cv::Point>>{pts}, cv::Scalar(1), cv::LINE_8, 8);
     // A stray speck elsewhere: the largest piece's contour is the one used.
@@ -98,7 +100,8 @@ TEST(SilhouetteFourierTest, RasterisedRotatedPolygonsAgree) {
   const ContourFourierOptions options;
   const cv::Mat a = raster(0, 100);
   const auto reference = *SilhouetteFourier({a.ptr<uint8_t>(0), a.cols, a.rows}, options);
-  for (const auto& [angle, scale] : std::vector<std::pair<double, double>>{{0.5, 100}, {2.0, 80}, {4.0, 120}}) {
+  for (const auto& [angle, scale] :
+       std::vector<std::pair<double, double>>{{0.5, 100}, {2.0, 80}, {4.0, 120}}) {
     const cv::Mat b = raster(angle, scale);
     const auto f = *SilhouetteFourier({b.ptr<uint8_t>(0), b.cols, b.rows}, options);
     for (int k = 0; k < kFourierCoefficients; ++k) EXPECT_NEAR(f[k], reference[k], 0.02) << k;

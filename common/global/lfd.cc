@@ -46,7 +46,9 @@ void ViewTableScalar(const uint8_t* a, const uint8_t* b, ViewTable* table) {
 // One view is a 32-byte and a 16-byte load; _mm256_sad_epu8 / _mm_sad_epu8
 // leave 64-bit partial sums of absolute byte differences, added up here.
 // Integer arithmetic: the same result as the scalar loop, bit for bit.
-__attribute__((target("avx2"))) void ViewTableAvx2(const uint8_t* a, const uint8_t* b, ViewTable* table) {
+__attribute__((target("avx2"))) void ViewTableAvx2(const uint8_t* a,
+                                                   const uint8_t* b,
+                                                   ViewTable* table) {
   for (int i = 0; i < kLfdViews; ++i) {
     const uint8_t* va = a + i * kLfdViewStride;
     const __m256i a0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(va));
@@ -54,10 +56,12 @@ __attribute__((target("avx2"))) void ViewTableAvx2(const uint8_t* a, const uint8
     int16_t* row = table->data() + i * kLfdViews;
     for (int j = 0; j < kLfdViews; ++j) {
       const uint8_t* vb = b + j * kLfdViewStride;
-      const __m256i s = _mm256_sad_epu8(a0, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(vb)));
-      const __m128i t = _mm_sad_epu8(a1, _mm_loadu_si128(reinterpret_cast<const __m128i*>(vb + 32)));
-      const __m128i u =
-          _mm_add_epi64(_mm_add_epi64(_mm256_castsi256_si128(s), _mm256_extracti128_si256(s, 1)), t);
+      const __m256i s =
+          _mm256_sad_epu8(a0, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(vb)));
+      const __m128i t =
+          _mm_sad_epu8(a1, _mm_loadu_si128(reinterpret_cast<const __m128i*>(vb + 32)));
+      const __m128i u = _mm_add_epi64(
+          _mm_add_epi64(_mm256_castsi256_si128(s), _mm256_extracti128_si256(s, 1)), t);
       row[Column(j)] = static_cast<int16_t>(_mm_cvtsi128_si32(u) + _mm_extract_epi32(u, 2));
     }
   }
@@ -120,7 +124,8 @@ __attribute__((target("avx2"))) int MinimumAvx2(const ViewTable& table) {
       const auto& off = o.offsets[p];
       __m256i sum = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(base + off[0]));
       for (int i = 1; i < kLfdViewsPerLightField; ++i) {
-        sum = _mm256_adds_epu16(sum, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(base + off[i])));
+        sum = _mm256_adds_epu16(
+            sum, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(base + off[i])));
       }
       best = _mm256_min_epu16(best, sum);
     }
@@ -163,7 +168,8 @@ uint8_t QuantizeLfdCoefficient(double value, double scale) {
   return q >= 255 ? 255 : static_cast<uint8_t>(q);
 }
 
-absl::StatusOr<std::vector<uint8_t>> ExtractLfd(const TriangleMesh& mesh, const LfdOptions& options) {
+absl::StatusOr<std::vector<uint8_t>> ExtractLfd(const TriangleMesh& mesh,
+                                                const LfdOptions& options) {
   if (absl::Status s = options.Validate(); !s.ok()) return s;
   if (absl::Status s = ValidateMesh(mesh); !s.ok()) {
     return absl::InvalidArgumentError(absl::StrCat("lfd: ", s.message()));
@@ -218,8 +224,8 @@ absl::StatusOr<std::vector<uint8_t>> ExtractLfd(const TriangleMesh& mesh, const 
 
 absl::Status ValidateLfdDescriptor(const std::vector<uint8_t>& descriptor) {
   if (descriptor.size() != kLfdDescriptorBytes) {
-    return absl::InvalidArgumentError(absl::StrCat("lfd descriptor: ", descriptor.size(),
-                                                   " bytes, expected ", kLfdDescriptorBytes));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "lfd descriptor: ", descriptor.size(), " bytes, expected ", kLfdDescriptorBytes));
   }
   for (int v = 0; v < kLfdViews; ++v) {
     for (int k = kLfdCoefficientsPerView; k < kLfdViewStride; ++k) {
@@ -254,8 +260,8 @@ float LfdDistance(const uint8_t* a, const uint8_t* b) {
   return internal::LfdDistanceAtLevel(a, b, DetectedSimdLevel());
 }
 
-absl::StatusOr<std::vector<float>> LfdDistanceMatrix(const std::vector<std::vector<uint8_t>>& descriptors,
-                                                     int num_threads) {
+absl::StatusOr<std::vector<float>> LfdDistanceMatrix(
+    const std::vector<std::vector<uint8_t>>& descriptors, int num_threads) {
   for (std::size_t i = 0; i < descriptors.size(); ++i) {
     if (absl::Status s = ValidateLfdDescriptor(descriptors[i]); !s.ok()) {
       return absl::InvalidArgumentError(absl::StrCat("model ", i, ": ", s.message()));

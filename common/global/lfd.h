@@ -65,7 +65,8 @@ inline constexpr int kLfdViewStride = 48;
 /// Views per model (10 light fields x 10 views).
 inline constexpr int kLfdViews = kLfdLightFields * kLfdViewsPerLightField;
 /// Size of a serialised descriptor.
-inline constexpr std::size_t kLfdDescriptorBytes = static_cast<std::size_t>(kLfdViews) * kLfdViewStride;
+inline constexpr std::size_t kLfdDescriptorBytes =
+    static_cast<std::size_t>(kLfdViews) * kLfdViewStride;
 /// Quantisation scales (q = min(255, floor(scale * value))).
 inline constexpr double kLfdZernikeScale = 256;
 inline constexpr double kLfdFourierScale = 512;
@@ -90,7 +91,8 @@ uint8_t QuantizeLfdCoefficient(double value, double scale);
 /// ValidateMesh rejects (no triangles, an index out of range, a non-finite
 /// coordinate, zero area) or whose enclosing sphere has no extent.
 /// Deterministic; single-threaded (parallelise across models).
-absl::StatusOr<std::vector<uint8_t>> ExtractLfd(const TriangleMesh& mesh, const LfdOptions& options);
+absl::StatusOr<std::vector<uint8_t>> ExtractLfd(const TriangleMesh& mesh,
+                                                const LfdOptions& options);
 
 /// InvalidArgument unless `descriptor` has kLfdDescriptorBytes bytes with
 /// zero padding (a descriptor ExtractLfd wrote). For data read from outside.
@@ -107,8 +109,8 @@ float LfdDistance(const uint8_t* a, const uint8_t* b);
 /// `num_threads` threads (<= 0: all cores); the result does not depend on
 /// the thread count. InvalidArgument when a descriptor fails
 /// ValidateLfdDescriptor (naming its index).
-absl::StatusOr<std::vector<float>> LfdDistanceMatrix(const std::vector<std::vector<uint8_t>>& descriptors,
-                                                     int num_threads);
+absl::StatusOr<std::vector<float>> LfdDistanceMatrix(
+    const std::vector<std::vector<uint8_t>>& descriptors, int num_threads);
 
 namespace internal {
 

@@ -37,9 +37,15 @@ Rotation3 ShoemakeRotation(double u1, double u2, double u3) {
   const double a = std::sqrt(1 - u1), b = std::sqrt(u1);
   const double w = a * std::sin(2 * kPi * u2), x = a * std::cos(2 * kPi * u2);
   const double y = b * std::sin(2 * kPi * u3), z = b * std::cos(2 * kPi * u3);
-  return {1 - 2 * (y * y + z * z), 2 * (x * y - z * w),     2 * (x * z + y * w),
-          2 * (x * y + z * w),     1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
-          2 * (x * z - y * w),     2 * (y * z + x * w),     1 - 2 * (x * x + y * y)};
+  return {1 - 2 * (y * y + z * z),
+          2 * (x * y - z * w),
+          2 * (x * z + y * w),
+          2 * (x * y + z * w),
+          1 - 2 * (x * x + z * z),
+          2 * (y * z - x * w),
+          2 * (x * z - y * w),
+          2 * (y * z + x * w),
+          1 - 2 * (x * x + y * y)};
 }
 
 // Distance between the camera systems R and S: the smallest angle of
@@ -63,9 +69,15 @@ double CameraSystemDistance(const Rotation3& r, const Rotation3& s) {
 const std::array<Vec3d, 20>& DodecahedronVertices() {
   static const std::array<Vec3d, 20> vertices = [] {
     const double phi = (1 + std::sqrt(5.0)) / 2, iphi = 1 / phi;
-    const std::array<Vec3d, 10> half = {Vec3d(1, 1, 1),     Vec3d(1, 1, -1),     Vec3d(1, -1, 1),
-                                        Vec3d(1, -1, -1),   Vec3d(0, iphi, phi), Vec3d(0, iphi, -phi),
-                                        Vec3d(iphi, phi, 0), Vec3d(iphi, -phi, 0), Vec3d(phi, 0, iphi),
+    const std::array<Vec3d, 10> half = {Vec3d(1, 1, 1),
+                                        Vec3d(1, 1, -1),
+                                        Vec3d(1, -1, 1),
+                                        Vec3d(1, -1, -1),
+                                        Vec3d(0, iphi, phi),
+                                        Vec3d(0, iphi, -phi),
+                                        Vec3d(iphi, phi, 0),
+                                        Vec3d(iphi, -phi, 0),
+                                        Vec3d(phi, 0, iphi),
                                         Vec3d(phi, 0, -iphi)};
     std::array<Vec3d, 20> all;
     for (int i = 0; i < 10; ++i) {
@@ -110,8 +122,8 @@ const std::vector<Rotation3>& IcosahedralRotations() {
       }
     }
     // Identity first (the edge sent onto itself), the rest in discovery order.
-    std::stable_partition(found.begin(), found.end(),
-                          [](const Rotation3& r) { return RotationAngle(r) < 1e-9; });
+    std::stable_partition(
+        found.begin(), found.end(), [](const Rotation3& r) { return RotationAngle(r) < 1e-9; });
     return found;
   }();
   return rotations;
@@ -149,9 +161,11 @@ const std::array<Rotation3, kLfdLightFields>& LightFieldRotations() {
     std::array<Rotation3, kLfdLightFields> picked;
     picked[0] = IcosahedralRotations()[0];
     std::vector<double> nearest(kCandidates);
-    for (int c = 0; c < kCandidates; ++c) nearest[c] = CameraSystemDistance(picked[0], candidates[c]);
+    for (int c = 0; c < kCandidates; ++c)
+      nearest[c] = CameraSystemDistance(picked[0], candidates[c]);
     for (int k = 1; k < kLfdLightFields; ++k) {
-      const int best = static_cast<int>(std::max_element(nearest.begin(), nearest.end()) - nearest.begin());
+      const int best =
+          static_cast<int>(std::max_element(nearest.begin(), nearest.end()) - nearest.begin());
       picked[k] = candidates[best];
       for (int c = 0; c < kCandidates; ++c) {
         nearest[c] = std::min(nearest[c], CameraSystemDistance(picked[k], candidates[c]));
@@ -167,7 +181,8 @@ double RotationAngle(const Rotation3& r) {
 }
 
 Vec3d Rotate(const Rotation3& r, const Vec3d& v) {
-  return {r[0] * v.x + r[1] * v.y + r[2] * v.z, r[3] * v.x + r[4] * v.y + r[5] * v.z,
+  return {r[0] * v.x + r[1] * v.y + r[2] * v.z,
+          r[3] * v.x + r[4] * v.y + r[5] * v.z,
           r[6] * v.x + r[7] * v.y + r[8] * v.z};
 }
 

@@ -59,7 +59,8 @@ TEST(IcosahedralRotationsTest, SixtyDistinctSymmetriesIdentityFirst) {
   for (std::size_t a = 0; a < rotations.size(); ++a) {
     for (std::size_t b = a + 1; b < rotations.size(); ++b) {
       double diff = 0;
-      for (int k = 0; k < 9; ++k) diff = std::max(diff, std::abs(rotations[a][k] - rotations[b][k]));
+      for (int k = 0; k < 9; ++k)
+        diff = std::max(diff, std::abs(rotations[a][k] - rotations[b][k]));
       EXPECT_GT(diff, 0.1) << a << " " << b;
     }
   }

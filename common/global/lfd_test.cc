@@ -19,7 +19,8 @@ using testing_meshes::AxisAngle;
 TriangleMesh Box(double sx, double sy, double sz, Vec3d at = {0, 0, 0}) {
   TriangleMesh m = testing_meshes::Cube(0.5f);
   for (Vec3f& v : m.vertices) {
-    v = Vec3f(static_cast<float>(v.x * sx + at.x), static_cast<float>(v.y * sy + at.y),
+    v = Vec3f(static_cast<float>(v.x * sx + at.x),
+              static_cast<float>(v.y * sy + at.y),
               static_cast<float>(v.z * sz + at.z));
   }
   return m;
@@ -113,7 +114,8 @@ TEST(ExtractLfdTest, FixedSizeZeroPaddingAndDeterministic) {
   EXPECT_EQ(a.size(), kLfdDescriptorBytes);
   EXPECT_TRUE(ValidateLfdDescriptor(a).ok());
   EXPECT_EQ(a, b);
-  EXPECT_EQ(ValidateLfdDescriptor(std::vector<uint8_t>(10)).code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(ValidateLfdDescriptor(std::vector<uint8_t>(10)).code(),
+            absl::StatusCode::kInvalidArgument);
   std::vector<uint8_t> padded = a;
   padded[kLfdCoefficientsPerView] = 1;
   EXPECT_EQ(ValidateLfdDescriptor(padded).code(), absl::StatusCode::kInvalidArgument);
@@ -127,7 +129,8 @@ TEST(ExtractLfdTest, EmptySilhouettesGiveZerosNotNan) {
   int empty_views = 0;
   for (int v = 0; v < kLfdViews; ++v) {
     const uint8_t* block = d.data() + v * kLfdViewStride;
-    if (std::all_of(block, block + kLfdCoefficientsPerView, [](uint8_t b) { return b == 0; })) ++empty_views;
+    if (std::all_of(block, block + kLfdCoefficientsPerView, [](uint8_t b) { return b == 0; }))
+      ++empty_views;
   }
   EXPECT_GE(empty_views, 1);
   EXPECT_EQ(LfdDistance(d.data(), d.data()), 0.0f);
@@ -144,7 +147,8 @@ TEST(LfdDistanceTest, ScalarAndAvx2PathsAgreeBitForBit) {
   for (int k = 0; k < 4; ++k) {
     std::vector<uint8_t> d(kLfdDescriptorBytes, 0);
     for (int v = 0; v < kLfdViews; ++v) {
-      for (int c = 0; c < kLfdCoefficientsPerView; ++c) d[v * kLfdViewStride + c] = static_cast<uint8_t>(byte(rng));
+      for (int c = 0; c < kLfdCoefficientsPerView; ++c)
+        d[v * kLfdViewStride + c] = static_cast<uint8_t>(byte(rng));
     }
     descriptors.push_back(d);
   }
@@ -153,7 +157,8 @@ TEST(LfdDistanceTest, ScalarAndAvx2PathsAgreeBitForBit) {
   // Nothing alike: 10 views x 45 x 255 = 114,750, past the vector kernel's
   // 16-bit sums, so the exact fallback decides.
   std::vector<uint8_t> full(kLfdDescriptorBytes, 0), empty(kLfdDescriptorBytes, 0);
-  for (int v = 0; v < kLfdViews; ++v) std::fill_n(full.begin() + v * kLfdViewStride, kLfdCoefficientsPerView, 255);
+  for (int v = 0; v < kLfdViews; ++v)
+    std::fill_n(full.begin() + v * kLfdViewStride, kLfdCoefficientsPerView, 255);
   EXPECT_EQ(internal::LfdDistanceAtLevel(full.data(), empty.data(), SimdLevel::kAvx2), 114750.0f);
   EXPECT_EQ(internal::LfdDistanceAtLevel(full.data(), empty.data(), SimdLevel::kSse2), 114750.0f);
   descriptors.push_back(full);
@@ -213,7 +218,8 @@ TEST(LfdDistanceTest, ZeroToItselfSymmetricAndNearlyInvariantToSimilarities) {
     const float to_moved = LfdDistance(d[i].data(), dm.data());
     EXPECT_LT(to_moved, nearest_other / 3) << shapes[i].name << ": to its moved copy " << to_moved
                                            << ", to the nearest other shape " << nearest_other;
-    EXPECT_EQ(LfdDistance(d[i].data(), Extract(testing_meshes::ToSoup(shapes[i].mesh)).data()), 0.0f)
+    EXPECT_EQ(LfdDistance(d[i].data(), Extract(testing_meshes::ToSoup(shapes[i].mesh)).data()),
+              0.0f)
         << shapes[i].name;
   }
 }

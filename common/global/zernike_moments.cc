@@ -68,12 +68,18 @@ double LargestRadius(const BinaryImageView& image, double cx, double cy) {
 absl::StatusOr<std::array<double, kZernikeCoefficients>> ZernikeMagnitudes(
     const BinaryImageView& image, double cx, double cy, double radius) {
   if (image.pixels == nullptr || image.width <= 0 || image.height <= 0) {
-    return absl::InvalidArgumentError(absl::StrCat("zernike: empty image (", image.width, " x ",
-                                                   image.height, ")"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("zernike: empty image (", image.width, " x ", image.height, ")"));
   }
   if (!(radius > 0) || !std::isfinite(radius) || !std::isfinite(cx) || !std::isfinite(cy)) {
-    return absl::InvalidArgumentError(absl::StrCat("zernike: radius must be positive and finite, got ",
-                                                   radius, " (centre ", cx, ", ", cy, ")"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("zernike: radius must be positive and finite, got ",
+                     radius,
+                     " (centre ",
+                     cx,
+                     ", ",
+                     cy,
+                     ")"));
   }
   // S_jm = sum (r^2)^j conj(z)^m, real and imaginary parts.
   double sr[kMaxJ + 1][kZernikeMaxOrder + 1] = {};

@@ -21,8 +21,10 @@ cv::Mat Polygon(int n, const std::vector<cv::Point2d>& shape, double angle, doub
   const double c = std::cos(angle), s = std::sin(angle);
   for (const cv::Point2d& p : shape) {
     // Sub-pixel precision for fillPoly: 8 fractional bits.
-    const double x = n / 2.0 + scale * (c * p.x - s * p.y), y = n / 2.0 + scale * (s * p.x + c * p.y);
-    points.emplace_back(static_cast<int>(std::lround(x * 256)), static_cast<int>(std::lround(y * 256)));
+    const double x = n / 2.0 + scale * (c * p.x - s * p.y),
+                 y = n / 2.0 + scale * (s * p.x + c * p.y);
+    points.emplace_back(static_cast<int>(std::lround(x * 256)),
+                        static_cast<int>(std::lround(y * 256)));
   }
   cv::fillPoly(m, std::vector<std::vector<cv::Point>>{points}, cv::Scalar(1), cv::LINE_8, 8);
   return m;
@@ -93,16 +95,19 @@ TEST(ZernikeMagnitudesTest, RotatedMirroredAndScaledImagesAgree) {
   EXPECT_GT(largest, 0.1);  // an asymmetric shape has sizeable moments
   cv::Mat mirrored;
   cv::flip(base, mirrored, 1);
-  for (const cv::Mat& other :
-       {Polygon(n, LShape(), 0.7, 150), Polygon(n, LShape(), 2.9, 150), Polygon(n, LShape(), 1.3, 110),
-        mirrored}) {
+  for (const cv::Mat& other : {Polygon(n, LShape(), 0.7, 150),
+                               Polygon(n, LShape(), 2.9, 150),
+                               Polygon(n, LShape(), 1.3, 110),
+                               mirrored}) {
     const auto z = describe(other);
     for (int i = 0; i < kZernikeCoefficients; ++i) EXPECT_NEAR(z[i], reference[i], 0.01) << i;
   }
   // A different shape differs by far more than that.
-  const auto square = describe(Polygon(n, {{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {-0.5, 0.5}}, 0, 150));
+  const auto square =
+      describe(Polygon(n, {{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {-0.5, 0.5}}, 0, 150));
   double diff = 0;
-  for (int i = 0; i < kZernikeCoefficients; ++i) diff = std::max(diff, std::abs(square[i] - reference[i]));
+  for (int i = 0; i < kZernikeCoefficients; ++i)
+    diff = std::max(diff, std::abs(square[i] - reference[i]));
   EXPECT_GT(diff, 0.05);
 }
 
