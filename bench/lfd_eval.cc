@@ -3,7 +3,7 @@
 // timings.
 //
 //   lfd_eval --manifest FILE [--threads=2] [--image_size=I] [--contour_samples=S]
-//            [--distances_out=FILE] [--descriptors_out=FILE]
+//            [--zernike_radius=view|lightfield] [--distances_out=FILE] [--descriptors_out=FILE]
 //
 // Labels are the manifest's `class` column (as `meshseek eval` and
 // bench/rank_check take them). Prints the metrics table (FormatMetricsTable,
@@ -37,6 +37,11 @@ ABSL_FLAG(int,
           contour_samples,
           meshseek::LfdOptions().contour_samples,
           "contour points for the Fourier descriptor");
+ABSL_FLAG(std::string,
+          zernike_radius,
+          "view",
+          "Zernike disc radius: view (each silhouette's own) or lightfield (shared by a light "
+          "field's 10 views, the original's)");
 ABSL_FLAG(std::string, distances_out, "", "write the N x N float32 distance matrix here");
 ABSL_FLAG(std::string, descriptors_out, "", "write the N descriptors here (raw bytes)");
 
@@ -70,6 +75,13 @@ int Run() {
   LfdOptions options;
   options.image_size = absl::GetFlag(FLAGS_image_size);
   options.contour_samples = absl::GetFlag(FLAGS_contour_samples);
+  const std::string radius = absl::GetFlag(FLAGS_zernike_radius);
+  if (radius != "view" && radius != "lightfield") {
+    std::fprintf(stderr, "--zernike_radius must be view or lightfield, got %s\n", radius.c_str());
+    return 2;
+  }
+  options.zernike_radius =
+      radius == "view" ? LfdZernikeRadius::kPerView : LfdZernikeRadius::kPerLightField;
   if (absl::Status s = options.Validate(); !s.ok()) {
     std::fprintf(stderr, "%s\n", s.ToString().c_str());
     return 2;
@@ -157,13 +169,16 @@ int Run() {
   std::sort(sorted.begin(), sorted.end());
   double total_cpu = 0;
   for (double s : cpu_s) total_cpu += s;
-  std::printf("%s: %zu models, LFD image_size %d, contour_samples %d, %d threads, SIMD %s\n",
-              manifest.c_str(),
-              n,
-              options.image_size,
-              options.contour_samples,
-              threads,
-              SimdLevelName(DetectedSimdLevel()));
+  std::printf(
+      "%s: %zu models, LFD image_size %d, contour_samples %d, zernike_radius %s, %d threads, "
+      "SIMD %s\n",
+      manifest.c_str(),
+      n,
+      options.image_size,
+      options.contour_samples,
+      radius.c_str(),
+      threads,
+      SimdLevelName(DetectedSimdLevel()));
   std::printf("%s", FormatMetricsTable(*metrics).c_str());
   std::printf(
       "timings: read meshes %.1f s; extraction per model (one core, thread CPU) median %.0f ms, "

@@ -154,6 +154,11 @@ absl::Status LfdOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("lfd: image_size must be in [32, 1024], got ", image_size));
   }
+  if (zernike_radius != LfdZernikeRadius::kPerView &&
+      zernike_radius != LfdZernikeRadius::kPerLightField) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("lfd: zernike_radius has no meaning: ", static_cast<int>(zernike_radius)));
+  }
   ContourFourierOptions fourier;
   fourier.samples = contour_samples;
   if (absl::Status s = fourier.Validate(); !s.ok()) {
@@ -190,21 +195,25 @@ absl::StatusOr<std::vector<uint8_t>> ExtractLfd(const TriangleMesh& mesh,
   std::array<std::vector<uint8_t>, kLfdViewsPerLightField> masks;
   std::array<SilhouetteCentroid, kLfdViewsPerLightField> centroids;
   for (int l = 0; l < kLfdLightFields; ++l) {
-    // The light field's 10 silhouettes first: they share one Zernike radius.
-    double radius = 0;
+    // The light field's 10 silhouettes first: they may share one Zernike
+    // radius.
+    std::array<double, kLfdViewsPerLightField> radii;
+    double shared = 0;
     for (int v = 0; v < kLfdViewsPerLightField; ++v) {
       masks[v] = renderer->Render(Rotate(rotations[l], directions[v])).mask;
       const BinaryImageView image{masks[v].data(), n, n};
       centroids[v] = ComputeCentroid(image);
-      radius = std::max(radius, LargestRadius(image, centroids[v].x, centroids[v].y));
+      radii[v] = LargestRadius(image, centroids[v].x, centroids[v].y);
+      shared = std::max(shared, radii[v]);
     }
-    // A silhouette of one pixel has radius 0 about its centroid: any
-    // positive radius then describes it (all its moments vanish but A_00).
-    if (!(radius > 0)) radius = 1;
     for (int v = 0; v < kLfdViewsPerLightField; ++v) {
       uint8_t* block = out.data() + (l * kLfdViewsPerLightField + v) * kLfdViewStride;
       if (centroids[v].pixels == 0) continue;  // sees nothing: zeros
       const BinaryImageView image{masks[v].data(), n, n};
+      double radius = options.zernike_radius == LfdZernikeRadius::kPerView ? radii[v] : shared;
+      // A silhouette of one pixel has radius 0 about its centroid: any
+      // positive radius then describes it (all its moments vanish but A_00).
+      if (!(radius > 0)) radius = 1;
       absl::StatusOr<std::array<double, kZernikeCoefficients>> zernike =
           ZernikeMagnitudes(image, centroids[v].x, centroids[v].y, radius);
       if (!zernike.ok()) return zernike.status();

@@ -11,9 +11,7 @@
 // is rendered (common/render/view_renderer.h) and described by
 //   - 35 Zernike moment magnitudes up to order 10 (zernike_moments.h),
 //     centred on the silhouette's centroid, over the disc whose radius is the
-//     largest centroid-to-pixel distance among the light field's 10
-//     silhouettes (as the original: one radius per light field, so that
-//     relative size between the views is kept);
+//     silhouette's largest centroid-to-pixel distance (LfdZernikeRadius);
 //   - 10 Fourier magnitudes of the outer contour's centroid distance
 //     (contour_fourier.h).
 // Each coefficient is quantised to 8 bits as the original does:
@@ -71,6 +69,18 @@ inline constexpr std::size_t kLfdDescriptorBytes =
 inline constexpr double kLfdZernikeScale = 256;
 inline constexpr double kLfdFourierScale = 512;
 
+/// The radius of the disc the Zernike moments of a silhouette are taken over.
+enum class LfdZernikeRadius {
+  /// The silhouette's own largest centroid-to-pixel distance: each view is
+  /// scale-normalised on its own.
+  kPerView,
+  /// The largest over the light field's 10 silhouettes, as we read the
+  /// original (its FindRadius takes the 10 images of a light field): the
+  /// views keep their relative sizes. Measured 1.2 to 1.7 points of first
+  /// tier below kPerView on McGill and PSB train (bench/results/lfd.txt).
+  kPerLightField,
+};
+
 struct LfdOptions {
   /// Silhouette side in pixels, 32 to 1024. The paper renders 256 x 256;
   /// 128 retrieves as well on McGill and PSB train at a third of the cost
@@ -79,6 +89,9 @@ struct LfdOptions {
   /// Points the outer contour is resampled to for the Fourier descriptor
   /// (contour_fourier.h; 21 to 65,536).
   int contour_samples = 128;
+  /// Zernike disc radius: per view (the default, measured better) or
+  /// shared by a light field's views (the original's).
+  LfdZernikeRadius zernike_radius = LfdZernikeRadius::kPerView;
 
   absl::Status Validate() const;
 };

@@ -74,6 +74,7 @@ TEST(LfdOptionsTest, DefaultsArePinnedAndValid) {
   const LfdOptions options;
   EXPECT_EQ(options.image_size, 128);
   EXPECT_EQ(options.contour_samples, 128);
+  EXPECT_EQ(options.zernike_radius, LfdZernikeRadius::kPerView);
   EXPECT_TRUE(options.Validate().ok());
   LfdOptions bad;
   bad.image_size = 16;
@@ -195,8 +196,8 @@ TEST(LfdDistanceTest, MatchesTheDefinition) {
 // The invariances, with their tolerance stated relative to how far apart
 // different shapes are: a rotated (uniformly random), scaled and moved copy
 // of a shape must be nearer to it than a third of its distance to the
-// nearest different shape. Measured (image_size 128): sphere 0, plank 0.08,
-// dumbbell 0.10, cube 0.10, jack 0.13, L 0.21 of that distance. Soups and
+// nearest different shape. Measured (defaults): sphere 0, plank 0.05,
+// cube 0.10, dumbbell 0.10, jack 0.15, L 0.18 of that distance. Soups and
 // welded meshes render alike, so they are at distance 0.
 TEST(LfdDistanceTest, ZeroToItselfSymmetricAndNearlyInvariantToSimilarities) {
   const std::vector<NamedShape> shapes = Shapes();
@@ -222,6 +223,21 @@ TEST(LfdDistanceTest, ZeroToItselfSymmetricAndNearlyInvariantToSimilarities) {
               0.0f)
         << shapes[i].name;
   }
+}
+
+// The original's shared radius is one option away and behaves the same way.
+TEST(ExtractLfdTest, SharedLightFieldRadiusAlsoWorks) {
+  LfdOptions shared;
+  shared.zernike_radius = LfdZernikeRadius::kPerLightField;
+  const TriangleMesh mesh = Shapes()[4].mesh;
+  auto a = ExtractLfd(mesh, shared);
+  ASSERT_TRUE(a.ok()) << a.status();
+  EXPECT_TRUE(ValidateLfdDescriptor(*a).ok());
+  EXPECT_EQ(LfdDistance(a->data(), a->data()), 0.0f);
+  EXPECT_NE(*a, Extract(mesh));
+  LfdOptions bad;
+  bad.zernike_radius = static_cast<LfdZernikeRadius>(7);
+  EXPECT_EQ(bad.Validate().code(), absl::StatusCode::kInvalidArgument);
 }
 
 TEST(LfdDistanceMatrixTest, MatchesPairwiseDistancesOnAnyThreadCount) {
