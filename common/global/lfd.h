@@ -16,8 +16,9 @@
 //     (contour_fourier.h).
 // Each coefficient is quantised to 8 bits as the original does:
 // q = min(255, floor(s * v)) with s = 256 for Zernike (v in [0, 1]) and
-// s = 512 for Fourier (the original's FD_SCALE of 2: the values are rarely
-// above 0.5). An empty silhouette (a view that sees nothing, e.g. a model
+// s = 512 for Fourier (the original's FD_SCALE of 2). On PSB train no byte
+// saturates; the median byte is 5 (Zernike) and 10 (Fourier), the 99th
+// percentile 175 and 165 (bench/results/lfd.txt). An empty silhouette (a view that sees nothing, e.g. a model
 // thinner than a pixel) gives zeros, never NaN.
 //
 // Descriptor layout (kLfdDescriptorBytes = 4,800 bytes, fixed): light field
@@ -35,10 +36,10 @@
 // entries, the 10 b light fields side by side in vector lanes. Both steps
 // use AVX2 where the CPU has it (_mm256_sad_epu8; 16-bit saturating sums,
 // exact below 65,535, the scalar code deciding above), and the scalar path
-// gives the same integers. The result is an integer (exact in float), symmetric, 0 from a
-// descriptor to itself, and, because the 10 light fields cover orientations
-// only at a finite spacing, only approximately invariant to rotating the
-// model (lfd_test.cc states by how much).
+// gives the same integers. The result is an integer (exact in float),
+// symmetric, 0 from a descriptor to itself, and, because the 10 light
+// fields cover orientations only at a finite spacing, only approximately
+// invariant to rotating the model (lfd_test.cc states by how much).
 #ifndef MESHSEEK_COMMON_GLOBAL_LFD_H_
 #define MESHSEEK_COMMON_GLOBAL_LFD_H_
 
