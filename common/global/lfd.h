@@ -17,8 +17,8 @@
 // Each coefficient is quantised to 8 bits as the original does:
 // q = min(255, floor(s * v)) with s = 256 for Zernike (v in [0, 1]) and
 // s = 512 for Fourier (the original's FD_SCALE of 2). On PSB train no byte
-// saturates; the median byte is 5 (Zernike) and 10 (Fourier), the 99th
-// percentile 175 and 165 (bench/results/lfd.txt). An empty silhouette (a view that sees nothing, e.g. a model
+// saturates; the median byte is 6 (Zernike) and 10 (Fourier), the 99th
+// percentile 139 and 165 (bench/results/lfd.txt). An empty silhouette (a view that sees nothing, e.g. a model
 // thinner than a pixel) gives zeros, never NaN.
 //
 // Descriptor layout (kLfdDescriptorBytes = 4,800 bytes, fixed): light field
