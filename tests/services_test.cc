@@ -231,12 +231,13 @@ class ServicesTest : public ::testing::Test {
     delete reference_;
   }
 
-  static absl::Status CreateCollection(v1::Coordinator::Stub* stub, const std::string& name) {
+  static absl::Status CreateCollection(v1::Coordinator::Stub* stub, const std::string& name,
+                                       const v1::PipelineParams& params = TestParams()) {
     grpc::ClientContext context;
     rpc::SetDeadline(&context, absl::Seconds(10));
     v1::CreateCollectionRequest request;
     request.set_name(name);
-    *request.mutable_params() = TestParams();
+    *request.mutable_params() = params;
     v1::Collection response;
     return rpc::FromGrpcStatus(stub->CreateCollection(&context, request, &response));
   }
@@ -576,6 +577,63 @@ TEST(ServicesLoadTest, SixtyFourConcurrentAddModelCallsToTheIndexAllSucceed) {
     EXPECT_TRUE(statuses[i].ok()) << "call " << i << ": " << statuses[i].error_code() << " "
                                   << statuses[i].error_message();
   }
+}
+
+// A collection of a global method (LFD): no codebook, one descriptor per
+// model in the index, ranked by the method's distance; over two shards, with
+// the index and the coordinator killed, it gives the in-process matrix.
+TEST_F(ServicesTest, AGlobalDescriptorCollectionSurvivesKillsAndEqualsInProcess) {
+  v1::PipelineParams params;
+  v1::ParamValue* method = params.add_values();
+  method->set_name("method");
+  method->set_value("lfd");
+  auto options = rpc::PipelineOptionsFromParams(params);
+  ASSERT_TRUE(options.ok()) << options.status();
+  auto reference = EvaluateCollection(*models_, *options);
+  ASSERT_TRUE(reference.ok()) << reference.status();
+  EXPECT_EQ(reference->codebook_size, 0u);
+
+  Stack stack(*dir_ + "/global", 1, 512, /*index_shards=*/2);
+  ASSERT_TRUE(stack.WaitServing());
+  auto stub = stack.Coordinator();
+  ASSERT_TRUE(CreateCollection(stub.get(), "lfd", params).ok());
+  const std::size_t n = models_->size();
+  std::set<std::string> jobs;
+  ASSERT_EQ(Ingest(stub.get(), "lfd", 0, n, &jobs), n);
+  for (const std::string& job : jobs) {
+    EXPECT_EQ(WaitJob(stub.get(), job).state(), v1::JOB_STATE_SUCCEEDED);
+  }
+  stack.index(0).Kill(SIGKILL);  // the build's adds are retried until it is back
+  const std::string build_id = Build(stub.get(), "lfd");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  stack.index(0).Start();
+  ASSERT_TRUE(stack.index(0).WaitServing());
+  const v1::JobStatus build = WaitJob(stub.get(), build_id);
+  ASSERT_EQ(build.state(), v1::JOB_STATE_SUCCEEDED) << build.DebugString();
+  EXPECT_EQ(Evaluate(stub.get(), "lfd"), reference->distances);
+
+  // Restored from the databases after kill -9.
+  stack.index(0).Kill(SIGKILL);
+  stack.index(1).Kill(SIGKILL);
+  stack.coordinator().Kill(SIGKILL);
+  stack.index(0).Start();
+  stack.index(1).Start();
+  stack.coordinator().Start();
+  ASSERT_TRUE(stack.WaitServing());
+  EXPECT_EQ(Evaluate(stub.get(), "lfd"), reference->distances);
+  // A query is its model's row of the matrix: itself first at distance 0.
+  v1::QueryResponse response;
+  const grpc::Status status = Query(stub.get(), "lfd", 5, 3, absl::Seconds(60), &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(response.results_size(), 3);
+  EXPECT_EQ(response.results(0).model_id(), (*models_)[5].id);
+  EXPECT_EQ(response.results(0).distance(), 0.0f);
+  EXPECT_EQ(response.results(1).distance(), [&] {
+    std::vector<float> row(reference->distances.begin() + 5 * n,
+                           reference->distances.begin() + 6 * n);
+    std::sort(row.begin(), row.end());
+    return row[1];
+  }());
 }
 
 TEST_F(ServicesTest, TwoIndexShardsGiveTheResultsOfOneAndNeverAPartialAnswer) {

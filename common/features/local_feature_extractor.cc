@@ -2,6 +2,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "common/base/status_macros.h"
 
 namespace meshseek {
 
@@ -32,6 +33,17 @@ absl::StatusOr<LocalFeatures> ExtractBf(const TriangleMesh& mesh,
   return ExtractBfDsift(mesh, options.bfdsift);
 }
 
+absl::StatusOr<LocalFeatures> ExtractLightField(const TriangleMesh& mesh,
+                                                const ExtractorOptions& options,
+                                                const PointGraph*) {
+  MESHSEEK_ASSIGN_OR_RETURN(std::vector<uint8_t> descriptor, ExtractLfd(mesh, options.lfd));
+  return GlobalDescriptorFeatures(std::move(descriptor));
+}
+
+float LightFieldDistance(const uint8_t* a, const uint8_t* b, std::size_t) {
+  return LfdDistance(a, b);
+}
+
 }  // namespace
 
 const std::vector<FeatureMethodInfo>& FeatureMethods() {
@@ -49,6 +61,10 @@ const std::vector<FeatureMethodInfo>& FeatureMethods() {
        "BF-DSIFT (Furuya & Ohbuchi): dense SIFT on depth views of the whole model",
        DescriptorKind::kBagOfFeatures, 8000,
        [](const ExtractorOptions& o) { return o.bfdsift.Validate(); }, ExtractBf},
+      {FeatureMethod::kLfd, "lfd",
+       "LFD (Chen et al.): Zernike and Fourier silhouette descriptors of 10 light fields",
+       DescriptorKind::kGlobal, 0, [](const ExtractorOptions& o) { return o.lfd.Validate(); },
+       ExtractLightField, LightFieldDistance, kLfdDescriptorBytes},
   };
   return *kMethods;
 }
@@ -80,11 +96,12 @@ absl::StatusOr<float> GlobalDistance(FeatureMethod method,
     return absl::InvalidArgumentError(
         absl::StrCat("method ", info.name, " has no global descriptor distance"));
   }
-  if (a.size() != 1 || b.size() != 1 || a.dimension != b.dimension ||
-      a.descriptors.size() != a.dimension || b.descriptors.size() != b.dimension) {
+  if (a.size() != 1 || b.size() != 1 || a.dimension != info.descriptor_bytes ||
+      b.dimension != info.descriptor_bytes || a.descriptors.size() != a.dimension ||
+      b.descriptors.size() != b.dimension) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "method ", info.name, ": a global descriptor is one feature of one dimension, got ",
-        a.size(), " of ", a.dimension, " and ", b.size(), " of ", b.dimension));
+        "method ", info.name, ": a global descriptor is one feature of ", info.descriptor_bytes,
+        " bytes, got ", a.size(), " of ", a.dimension, " and ", b.size(), " of ", b.dimension));
   }
   return info.distance(a.descriptors.data(), b.descriptors.data(), a.dimension);
 }

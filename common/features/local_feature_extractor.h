@@ -17,11 +17,12 @@
 #include "common/features/ld_sift.h"
 #include "common/features/local_features.h"
 #include "common/features/rld_sift.h"
+#include "common/global/lfd.h"
 #include "common/geometry/mesh.h"
 
 namespace meshseek {
 
-enum class FeatureMethod { kDldSift, kLdSift, kRldSift, kBfDsift };
+enum class FeatureMethod { kDldSift, kLdSift, kRldSift, kBfDsift, kLfd };
 
 // How a method's features become a model's signature: a bag of features over
 // a codebook learnt from the collection (the local methods), or one
@@ -39,7 +40,8 @@ struct FeatureMethodInfo {
   /// What it is, for --help.
   const char* title;
   DescriptorKind kind;
-  /// The codebook size measured best for its features (bag of features).
+  /// The codebook size measured best for its features (bag of features;
+  /// 0 for a global method).
   int vocabulary;
   /// Validates the method's options in ExtractorOptions.
   absl::Status (*validate)(const ExtractorOptions& options);
@@ -50,6 +52,8 @@ struct FeatureMethodInfo {
   /// kGlobal: the distance of two models' descriptors (GlobalDescriptorFeatures)
   /// of `dimension` bytes; symmetric, 0 for equal ones. nullptr otherwise.
   float (*distance)(const uint8_t* a, const uint8_t* b, std::size_t dimension) = nullptr;
+  /// kGlobal: the descriptor's size in bytes (what `distance` reads).
+  std::size_t descriptor_bytes = 0;
 };
 
 /// The distance of a global method between two models' features; InvalidArgument
@@ -75,6 +79,7 @@ struct ExtractorOptions {
   LdSiftOptions ld;
   RldSiftOptions rld;
   BfDsiftOptions bfdsift;
+  LfdOptions lfd;
 
   /// Validates the options of the selected method.
   absl::Status Validate() const;

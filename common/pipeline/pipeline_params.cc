@@ -22,6 +22,7 @@ constexpr FeatureMethod kDld = FeatureMethod::kDldSift;
 constexpr FeatureMethod kLd = FeatureMethod::kLdSift;
 constexpr FeatureMethod kRld = FeatureMethod::kRldSift;
 constexpr FeatureMethod kBf = FeatureMethod::kBfDsift;
+constexpr FeatureMethod kLfd = FeatureMethod::kLfd;
 
 // Canonical text of a value: integers in full, doubles shortest round-trip.
 std::string Text(int v) { return absl::StrCat(v); }
@@ -171,8 +172,17 @@ std::vector<ParamSpec> MakeSpecs() {
       "view_level", "view directions: vertices of the icosahedron subdivided this often (1: 42)",
       0, 3, listed, {kBf}, +[](Options& o) -> int& { return o.extractor.bfdsift.view_level; }));
   specs.push_back(Field<int>("view_size", "side of each whole-model view in pixels", 32, 1024,
-                             listed, {kBf},
-                             +[](Options& o) -> int& { return o.extractor.bfdsift.view_size; }));
+                             listed, {kBf, kLfd}, +[](Options& o) -> int& {
+                               return o.extractor.method == kLfd ? o.extractor.lfd.image_size
+                                                                 : o.extractor.bfdsift.view_size;
+                             }));
+  specs.push_back(Field<int>(
+      "contour_samples", "points the silhouette's outer contour is resampled to (Fourier)", 21,
+      65536, listed, {kLfd}, +[](Options& o) -> int& { return o.extractor.lfd.contour_samples; }));
+  specs.push_back(Choice<LfdZernikeRadius>(
+      "zernike_radius", "Zernike disc radius: per view | per light field (the original's)", listed,
+      {kLfd}, +[](Options& o) -> LfdZernikeRadius& { return o.extractor.lfd.zernike_radius; },
+      {{"view", LfdZernikeRadius::kPerView}, {"lightfield", LfdZernikeRadius::kPerLightField}}));
   specs.push_back(Field<int>(
       "points_per_view", "dense grid points per view inside the silhouette", 1, 100000, listed,
       {kBf}, +[](Options& o) -> int& { return o.extractor.bfdsift.points_per_view; }));

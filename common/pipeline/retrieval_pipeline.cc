@@ -40,7 +40,10 @@ RetrievalPipelineOptions::RetrievalPipelineOptions() {
 RetrievalPipelineOptions RetrievalPipelineOptions::ForMethod(FeatureMethod method) {
   RetrievalPipelineOptions options;
   options.extractor.method = method;
-  options.kmeans.num_centroids = FeatureMethodInfoOf(method).vocabulary;
+  // A global method has no codebook: the (unused) default stays.
+  if (FeatureMethodInfoOf(method).vocabulary > 0) {
+    options.kmeans.num_centroids = FeatureMethodInfoOf(method).vocabulary;
+  }
   return options;
 }
 

@@ -16,9 +16,10 @@ absl::StatusOr<GlobalDescriptorIndex> GlobalDescriptorIndex::Create(FeatureMetho
     return absl::InvalidArgumentError(
         absl::StrCat("global index: method ", info.name, " has no global descriptor"));
   }
-  if (dimension == 0 || dimension > kMaxDescriptorDimension) {
-    return absl::InvalidArgumentError(absl::StrCat("global index: descriptor size ", dimension,
-                                                   ", expected 1 to ", kMaxDescriptorDimension));
+  if (dimension != info.descriptor_bytes) {
+    return absl::InvalidArgumentError(absl::StrCat("global index: ", info.name,
+                                                   " descriptor of ", dimension,
+                                                   " bytes, expected ", info.descriptor_bytes));
   }
   GlobalDescriptorIndex index(method, dimension);
   index.distance_ = info.distance;

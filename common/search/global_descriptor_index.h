@@ -25,8 +25,8 @@ namespace meshseek {
 
 class GlobalDescriptorIndex {
  public:
-  /// InvalidArgument unless `method` is global and dimension is in
-  /// [1, kMaxDescriptorDimension].
+  /// InvalidArgument unless `method` is global and dimension is its
+  /// descriptor_bytes.
   static absl::StatusOr<GlobalDescriptorIndex> Create(FeatureMethod method, std::size_t dimension);
 
   FeatureMethod method() const { return method_; }
