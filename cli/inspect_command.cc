@@ -1,9 +1,13 @@
-// `meshseek inspect MODEL --method ld|rld|dld --out DIR`: what the detector and
+// `meshseek inspect MODEL --method METHOD --out DIR`: what the detector and
 // the renderer did on one model, for a person to look at.
 //   DIR/points.ply        the feature points, coloured by scale-space level
 //   DIR/points.png        the model seen along its smallest principal axis,
 //                         shaded by depth, with the visible feature points
 //   DIR/depth_images.png  a montage of depth images of a sample of features
+//                         (local methods)
+//   DIR/views.png         the whole-model views the method describes: BF-DSIFT's
+//                         depth images with their sample points, LFD's
+//                         silhouettes of its first light field
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -28,6 +32,9 @@
 #include "common/rpc/mesh_limit_flags.h"
 #include "common/geometry/principal_axes.h"
 #include "common/geometry/triangle_bvh.h"
+#include "common/geometry/icosphere.h"
+#include "common/global/lfd_cameras.h"
+#include "common/render/view_renderer.h"
 
 ABSL_DECLARE_FLAG(std::string, out);
 ABSL_FLAG(int, montage_images, 48, "inspect: depth images in the montage");
@@ -156,6 +163,53 @@ absl::Status WriteMontage(const std::string& path,
   return absl::OkStatus();
 }
 
+// The whole-model views of bfdsift (depth, with the points sampled in each)
+// and lfd (the first light field's silhouettes), side by side.
+absl::Status WriteViews(const std::string& path, const TriangleMesh& mesh,
+                        const RetrievalPipelineOptions& options, const LocalFeatures& features) {
+  const bool lfd = options.extractor.method == FeatureMethod::kLfd;
+  ViewRenderOptions render;
+  render.image_size = lfd ? options.extractor.lfd.image_size : options.extractor.bfdsift.view_size;
+  MESHSEEK_ASSIGN_OR_RETURN(const ViewRenderer renderer, ViewRenderer::Create(mesh, render));
+  std::vector<Vec3d> directions;
+  if (lfd) {
+    for (const Vec3d& d : LightFieldViewDirections()) directions.push_back(d);
+  } else {
+    directions = IcosphereDirections(options.extractor.bfdsift.view_level);
+  }
+  const int n = render.image_size, columns = std::min<int>(7, directions.size());
+  const int rows = (static_cast<int>(directions.size()) + columns - 1) / columns;
+  cv::Mat montage(rows * (n + 4), columns * (n + 4), CV_8UC3, cv::Scalar(255, 255, 255));
+  for (std::size_t v = 0; v < directions.size(); ++v) {
+    const ViewCamera camera = CameraFor(directions[v]);
+    const ViewImage view = renderer.Render(camera);
+    cv::Mat image(n, n, CV_8UC3);
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        const uint8_t g = lfd ? (view.Covered(x, y) ? 0 : 255)
+                              : static_cast<uint8_t>(view.Covered(x, y) ? 40 + 215 * view.DepthAt(x, y) : 0);
+        image.at<cv::Vec3b>(y, x) = cv::Vec3b(g, g, g);
+      }
+    }
+    if (!lfd) {
+      // The sample points of this view (keypoints carry its direction).
+      const Vec3d centre = renderer.sphere().center;
+      const double radius = renderer.sphere().radius;
+      for (const Keypoint& k : features.keypoints) {
+        if (Dot(Vec3d(k.view.x, k.view.y, k.view.z), camera.direction) < 0.9999) continue;
+        const Vec3d q = (Vec3d(k.position.x, k.position.y, k.position.z) - centre) / radius;
+        const int px = static_cast<int>((Dot(q, camera.right) + 1) / 2 * n);
+        const int py = static_cast<int>((1 - Dot(q, camera.up)) / 2 * n);
+        cv::circle(image, cv::Point(px, py), 1, cv::Scalar(40, 40, 230), cv::FILLED);
+      }
+    }
+    image.copyTo(montage(cv::Rect(static_cast<int>(v % columns) * (n + 4) + 2,
+                                  static_cast<int>(v / columns) * (n + 4) + 2, n, n)));
+  }
+  if (!cv::imwrite(path, montage)) return absl::PermissionDeniedError(absl::StrCat(path, ": cannot write"));
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::Status RunInspect(const std::string& model_path) {
@@ -170,6 +224,14 @@ absl::Status RunInspect(const std::string& model_path) {
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec) return absl::PermissionDeniedError(absl::StrCat(out_dir, ": cannot create folder"));
+  const FeatureMethod method = options.extractor.method;
+  if (method == FeatureMethod::kBfDsift || method == FeatureMethod::kLfd) {
+    MESHSEEK_RETURN_IF_ERROR(WriteViews(out_dir + "/views.png", mesh, options, features));
+    std::printf("%s: %s\n%s: %zu features (%zu bytes each)\nwrote %s/views.png\n",
+                model_path.c_str(), report.Summary().c_str(), FeatureMethodName(method),
+                features.size(), features.dimension, out_dir.c_str());
+    return absl::OkStatus();
+  }
   MESHSEEK_RETURN_IF_ERROR(WritePointsPly(out_dir + "/points.ply", features));
   MESHSEEK_RETURN_IF_ERROR(WriteOverview(out_dir + "/points.png", mesh, features));
   MESHSEEK_RETURN_IF_ERROR(WriteMontage(out_dir + "/depth_images.png",
