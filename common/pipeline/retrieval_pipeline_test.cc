@@ -90,3 +90,28 @@ TEST(RetrievalPipelineTest, EmptyCollectionIsAnError) {
 
 }  // namespace
 }  // namespace meshseek
+
+namespace meshseek {
+namespace {
+
+TEST(RankGlobalCollectionTest, IsTheMethodsOwnAllPairsMatrixAndRefusesOtherFeatures) {
+  RetrievalPipelineOptions options = RetrievalPipelineOptions::ForMethod(FeatureMethod::kLfd);
+  std::vector<LocalFeatures> features;
+  std::vector<std::vector<uint8_t>> descriptors;
+  for (const TriangleMesh& mesh :
+       {testing_meshes::Cube(), testing_meshes::Icosphere(2), testing_meshes::Plane(4)}) {
+    auto lfd = ExtractLfd(mesh, options.extractor.lfd);
+    ASSERT_TRUE(lfd.ok()) << lfd.status();
+    descriptors.push_back(*lfd);
+    features.push_back(GlobalDescriptorFeatures(*lfd));
+  }
+  const auto matrix = RankGlobalCollection(features, options);
+  ASSERT_TRUE(matrix.ok()) << matrix.status();
+  EXPECT_EQ(*matrix, *LfdDistanceMatrix(descriptors, 1));
+  features[1].dimension = 128;  // SIFT-sized: not an LFD descriptor
+  EXPECT_EQ(RankGlobalCollection(features, options).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace meshseek
