@@ -24,6 +24,7 @@
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
+#include "absl/strings/str_cat.h"
 #include "cli/pipeline_flags.h"
 #include "common/features/local_feature_extractor.h"
 #include "common/geometry/mesh_io.h"
@@ -115,15 +116,17 @@ void BM_Extract(benchmark::State& state, FeatureMethod method) {
   options.method = method;
   TimeExtraction(state, options);
 }
-BENCHMARK_CAPTURE(BM_Extract, dld, FeatureMethod::kDldSift)
-    ->Unit(benchmark::kMillisecond)
-    ->Iterations(1);
-BENCHMARK_CAPTURE(BM_Extract, ld, FeatureMethod::kLdSift)
-    ->Unit(benchmark::kMillisecond)
-    ->Iterations(1);
-BENCHMARK_CAPTURE(BM_Extract, rld, FeatureMethod::kRldSift)
-    ->Unit(benchmark::kMillisecond)
-    ->Iterations(1);
+// BM_Extract/<name> for every registered method (FeatureMethods()).
+void RegisterMethodBenchmarks() {
+  for (const FeatureMethodInfo& info : FeatureMethods()) {
+    benchmark::RegisterBenchmark(absl::StrCat("BM_Extract/", info.name).c_str(),
+                                 [method = info.method](benchmark::State& state) {
+                                   BM_Extract(state, method);
+                                 })
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(1);
+  }
+}
 
 void BM_ExtractRldSamples(benchmark::State& state) {
   ExtractorOptions options = BaseOptions();
@@ -152,6 +155,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   meshseek::BaseOptions() = options->extractor;
+  meshseek::RegisterMethodBenchmarks();
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;
