@@ -326,7 +326,7 @@ absl::Status RunQuery(const std::string& model_path) {
   v1::QueryResponse response;
   MESHSEEK_RETURN_IF_ERROR(Call(session->stub(), &v1::Coordinator::Stub::Query, request, &response,
                                 absl::Minutes(5)));
-  std::printf("%u local features; nearest in '%s':\n", response.query_features(), collection.c_str());
+  std::printf("%u features; nearest in '%s':\n", response.query_features(), collection.c_str());
   std::printf("%4s  %-24s %-16s %s\n", "rank", "model", "label", "distance");
   int rank = 0;
   for (const v1::ScoredModel& r : response.results()) {
@@ -348,14 +348,19 @@ absl::Status RunStatus() {
   get.set_name(collection);
   v1::Collection info;
   MESHSEEK_RETURN_IF_ERROR(Call(session->stub(), &v1::Coordinator::Stub::GetCollection, get, &info));
+  std::string params;
+  for (const v1::ParamValue& v : info.params().values()) {
+    absl::StrAppend(&params, params.empty() ? "" : " ", v.name(), "=", v.value());
+  }
+  if (params.empty()) params = info.params().ShortDebugString();  // a legacy collection
   std::printf("collection %s: %llu models, %llu pending, %llu extracted, %llu failed, %llu indexed; "
-              "codebook '%s'\nparams: %s\n",
+              "index generation '%s'\nparams: %s\n",
               info.name().c_str(), static_cast<unsigned long long>(info.models()),
               static_cast<unsigned long long>(info.pending()),
               static_cast<unsigned long long>(info.extracted()),
               static_cast<unsigned long long>(info.failed()),
               static_cast<unsigned long long>(info.indexed()), info.codebook_id().c_str(),
-              info.params().ShortDebugString().c_str());
+              params.c_str());
   // Every failed model and why, a page at a time.
   v1::ListCollectionModelsRequest list;
   list.set_collection(collection);
@@ -486,7 +491,10 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
                                                       " models, the manifest ", n));
   }
   for (std::size_t f : evaluation.features_per_model) evaluation.models_without_features += f == 0;
-  evaluation.codebook_size = options.kmeans.num_centroids;
+  evaluation.codebook_size =
+      FeatureMethodInfoOf(options.extractor.method).kind == DescriptorKind::kGlobal
+          ? 0
+          : options.kmeans.num_centroids;
   std::vector<std::string> labels;
   for (const ManifestEntry& m : models) labels.push_back(m.label);
   MESHSEEK_ASSIGN_OR_RETURN(evaluation.metrics,

@@ -43,14 +43,18 @@ absl::Status RunEval() {
   std::printf("R-precision (query excluded = first tier): %.1f %% micro, %.1f %% macro\n",
               100 * evaluation.metrics.micro.rp_excl,
               100 * evaluation.metrics.macro.rp_excl);
+  const std::string signature =
+      evaluation.codebook_size > 0
+          ? absl::StrCat("codebook V = ", evaluation.codebook_size)
+          : absl::StrCat("global descriptors of ", FeatureMethodName(options.extractor.method));
   std::printf(
       EvalInProcess()
-          ? "%zu models, codebook V = %zu; time %.1f s (extract %.1f, codebook %.1f, encode %.1f, "
+          ? "%zu models, %s; time %.1f s (extract %.1f, codebook %.1f, encode %.1f, "
             "rank %.1f)\n"
-          : "%zu models, codebook V = %zu; time %.1f s (ingest+extract %.1f, codebook+encode+index "
+          : "%zu models, %s; time %.1f s (ingest+extract %.1f, codebook+encode+index "
             "%.1f, -, distances+metrics %.1f)\n",
       evaluation.models.size(),
-      evaluation.codebook_size,
+      signature.c_str(),
       t.total_seconds,
       t.extract_seconds,
       t.codebook_seconds,
