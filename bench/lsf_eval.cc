@@ -39,10 +39,13 @@ ABSL_FLAG(int, min_support_samples, meshseek::LsfOptions().min_support_samples,
           "fewer support samples: no feature");
 ABSL_FLAG(int, max_support_samples, meshseek::LsfOptions().max_support_samples,
           "support samples entering the relations at most");
-ABSL_FLAG(std::string, relations, "default", "pairs or centre");
+ABSL_FLAG(std::string, relations, "default", "pairs, centre or both");
 ABSL_FLAG(std::string, layout, "default", "concatenated, distance_joint or full_joint");
 ABSL_FLAG(int, distance_bins, meshseek::LsfOptions().distance_bins, "bins over distance");
 ABSL_FLAG(int, angle_bins, meshseek::LsfOptions().angle_bins, "bins over each angle");
+ABSL_FLAG(bool, soft_binning, meshseek::LsfOptions().soft_binning, "linear interpolation between bins");
+ABSL_FLAG(bool, pca_centre_normal, meshseek::LsfOptions().pca_centre_normal,
+          "centre normal from the support's weighted PCA");
 ABSL_FLAG(bool, root, meshseek::LsfOptions().root, "square-root (Hellinger) normalisation");
 
 namespace meshseek {
@@ -70,13 +73,17 @@ absl::StatusOr<LsfOptions> OptionsFromFlags() {
   o.distance_bins = absl::GetFlag(FLAGS_distance_bins);
   o.angle_bins = absl::GetFlag(FLAGS_angle_bins);
   o.root = absl::GetFlag(FLAGS_root);
+  o.soft_binning = absl::GetFlag(FLAGS_soft_binning);
+  o.pca_centre_normal = absl::GetFlag(FLAGS_pca_centre_normal);
   const std::string relations = absl::GetFlag(FLAGS_relations);
   if (relations == "pairs") {
     o.relations = LsfOptions::Relations::kPairs;
   } else if (relations == "centre") {
     o.relations = LsfOptions::Relations::kCentre;
+  } else if (relations == "both") {
+    o.relations = LsfOptions::Relations::kBoth;
   } else if (relations != "default") {
-    return absl::InvalidArgumentError("--relations must be pairs or centre, got " + relations);
+    return absl::InvalidArgumentError("--relations must be pairs, centre or both, got " + relations);
   }
   const std::string layout = absl::GetFlag(FLAGS_layout);
   if (layout == "concatenated") {

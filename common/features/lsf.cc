@@ -8,28 +8,36 @@
 #include "common/base/status_macros.h"
 #include "common/geometry/enclosing_sphere.h"
 #include "common/geometry/point_grid.h"
+#include "common/geometry/principal_axes.h"
 #include "common/geometry/surface_sampler.h"
 
 namespace meshseek {
 namespace {
 
-// Angle bins are uniform in angle but the relations are cosines: the bin of
-// |cos| c is the number of bin edges cos(k pi / (2 bins)), k = 1..bins-1, above
-// c, which needs no acos per pair.
-class AngleBinner {
- public:
-  explicit AngleBinner(int bins) {
-    for (int k = 1; k < bins; ++k) edges_.push_back(std::cos(k * M_PI / (2.0 * bins)));
-  }
-  int operator()(float abs_cos) const {
-    int bin = 0;
-    for (float edge : edges_) bin += abs_cos < edge;
-    return bin;
-  }
-
- private:
-  std::vector<float> edges_;
+// A value in [0, 1] spread over `bins` bins: all of it into its bin (hard),
+// or split linearly between the two nearest bin centres (soft; the outer half
+// bins keep what lies beyond their centre).
+struct BinWeights {
+  int bin[2];
+  float weight[2];
 };
+BinWeights Spread(float x, int bins, bool soft) {
+  if (!soft) {
+    const int b = std::min(bins - 1, static_cast<int>(x * bins));
+    return {{b, b}, {1.0f, 0.0f}};
+  }
+  const float u = std::clamp(x * bins - 0.5f, 0.0f, static_cast<float>(bins - 1));
+  const int b = std::min(bins - 2, static_cast<int>(u));
+  if (bins == 1) return {{0, 0}, {1.0f, 0.0f}};
+  const float f = u - b;
+  return {{b, b + 1}, {1.0f - f, f}};
+}
+
+// The angle coordinate of an absolute cosine c = cos(theta), theta in
+// [0, pi/2]: sqrt(1 - c) = sqrt(2) sin(theta / 2), within 10% of theta / (pi/2)
+// and linear near 0 where most normal pairs of a smooth surface lie, at the
+// cost of one square root instead of an acos per relation.
+float AngleCoordinate(float abs_cos) { return std::sqrt(std::max(0.0f, 1.0f - std::min(1.0f, abs_cos))); }
 
 // Any unit vector normal to unit n (the keypoint's image up axis is not used
 // by LSF, but Keypoint promises one).
@@ -40,43 +48,76 @@ Vec3f Perpendicular(const Vec3f& n) {
 
 class Histogrammer {
  public:
-  explicit Histogrammer(const LsfOptions& options)
-      : options_(options), angle_(options.angle_bins), histogram_(options.Dimension()) {}
+  // `ordered`: the relations are the centre's with a support sample, whose
+  // two normal-line angles mean different things and get histograms of their
+  // own; a pair of support samples is unordered and pools them.
+  Histogrammer(const LsfOptions& options, bool ordered)
+      : options_(options), ordered_(ordered), histogram_(options.PartDimension(ordered)) {}
 
   void Clear() { std::fill(histogram_.begin(), histogram_.end(), 0.0f); }
 
-  // One pair; d in [0, 1] (clamped), cosines as |n_i . n_j|, |n_i . v|, |n_j . v|.
+  // One relation; d in [0, 1], cosines as |n_i . n_j|, |n_i . v|, |n_j . v|.
+  // Each pair counts 2 in the (d, a_nn) part and 1 per normal in the (d, a_nl)
+  // part, so both parts weigh the same.
   void Add(float d, float cos_nn, float cos_il, float cos_jl) {
     const int nd = options_.distance_bins, na = options_.angle_bins;
-    const int bd = std::min(nd - 1, static_cast<int>(d * nd));
-    const int bnn = angle_(cos_nn), bi = angle_(cos_il), bj = angle_(cos_jl);
+    const bool soft = options_.soft_binning;
+    const BinWeights wd = Spread(d, nd, soft);
+    const BinWeights wnn = Spread(AngleCoordinate(cos_nn), na, soft);
+    const BinWeights wi = Spread(AngleCoordinate(cos_il), na, soft);
+    const BinWeights wj = Spread(AngleCoordinate(cos_jl), na, soft);
+    float* h = histogram_.data();
+    // Ordered: i's and j's line angles in parts of their own, each relation
+    // counting once per part; unordered: one pooled part, the pair counting
+    // 2 in the normal-normal part so that both parts weigh the same.
+    const float nn_weight = ordered_ ? 1.0f : 2.0f;
+    const int j_part = ordered_ ? 1 : 0;
     switch (options_.layout) {
       case LsfOptions::Layout::kConcatenated:
-        histogram_[bd] += 2;
-        histogram_[nd + bnn] += 2;
-        histogram_[nd + na + bi] += 1;
-        histogram_[nd + na + bj] += 1;
+        for (int x = 0; x < 2; ++x) {
+          h[wd.bin[x]] += nn_weight * wd.weight[x];
+          h[nd + wnn.bin[x]] += nn_weight * wnn.weight[x];
+          h[nd + na + wi.bin[x]] += wi.weight[x];
+          h[nd + (1 + j_part) * na + wj.bin[x]] += wj.weight[x];
+        }
         break;
       case LsfOptions::Layout::kDistanceJoint:
-        histogram_[bd * na + bnn] += 2;
-        histogram_[nd * na + bd * na + bi] += 1;
-        histogram_[nd * na + bd * na + bj] += 1;
+        for (int x = 0; x < 2; ++x) {
+          for (int y = 0; y < 2; ++y) {
+            const int row = wd.bin[x] * na;
+            h[row + wnn.bin[y]] += nn_weight * wd.weight[x] * wnn.weight[y];
+            h[nd * na + row + wi.bin[y]] += wd.weight[x] * wi.weight[y];
+            h[(1 + j_part) * nd * na + row + wj.bin[y]] += wd.weight[x] * wj.weight[y];
+          }
+        }
         break;
-      case LsfOptions::Layout::kFullJoint:
-        histogram_[((bd * na + bnn) * na + std::min(bi, bj)) * na + std::max(bi, bj)] += 1;
+      case LsfOptions::Layout::kFullJoint: {
+        // Unordered pairs: (smaller, larger) normal-line angle.
+        const bool swap = !ordered_ && cos_il < cos_jl;
+        const BinWeights& lo = swap ? wj : wi;
+        const BinWeights& hi = swap ? wi : wj;
+        for (int x = 0; x < 2; ++x)
+          for (int y = 0; y < 2; ++y)
+            for (int z = 0; z < 2; ++z)
+              for (int w = 0; w < 2; ++w) {
+                h[((wd.bin[x] * na + wnn.bin[y]) * na + lo.bin[z]) * na + hi.bin[w]] +=
+                    wd.weight[x] * wnn.weight[y] * lo.weight[z] * hi.weight[w];
+              }
         break;
+      }
     }
   }
 
-  // Normalised and quantised onto the end of `out`.
-  void Emit(std::vector<uint8_t>* out) const {
+  // `parts` descriptors are concatenated (kBoth): each gets an L2 norm of
+  // 512 / sqrt(parts), so the whole has SIFT's 512.
+  void Emit(int parts, std::vector<uint8_t>* out) const {
     double norm = 0;
     std::vector<double> v(histogram_.begin(), histogram_.end());
     for (double& x : v) {
       if (options_.root) x = std::sqrt(x);
       norm += x * x;
     }
-    const double scale = norm > 0 ? 512.0 / std::sqrt(norm) : 0.0;
+    const double scale = norm > 0 ? 512.0 / std::sqrt(parts * norm) : 0.0;
     for (double x : v) {
       out->push_back(static_cast<uint8_t>(std::min(255.0, std::round(x * scale))));
     }
@@ -84,19 +125,25 @@ class Histogrammer {
 
  private:
   const LsfOptions& options_;
-  AngleBinner angle_;
+  const bool ordered_;
   std::vector<float> histogram_;
 };
 
 }  // namespace
 
 std::size_t LsfOptions::Dimension() const {
+  return (relations != Relations::kCentre ? PartDimension(false) : 0) +
+         (relations != Relations::kPairs ? PartDimension(true) : 0);
+}
+
+std::size_t LsfOptions::PartDimension(bool centre) const {
   const std::size_t nd = std::max(distance_bins, 0), na = std::max(angle_bins, 0);
+  const std::size_t line_angles = centre ? 2 : 1;
   switch (layout) {
     case Layout::kConcatenated:
-      return nd + 2 * na;
+      return nd + (1 + line_angles) * na;
     case Layout::kDistanceJoint:
-      return 2 * nd * na;
+      return (1 + line_angles) * nd * na;
     case Layout::kFullJoint:
       return nd * na * na * na;
   }
@@ -119,8 +166,9 @@ absl::Status LsfOptions::Validate() const {
   if (max_support_samples < min_support_samples || max_support_samples > 4096) {
     return bad("max_support_samples", max_support_samples, "in [min_support_samples, 4096]");
   }
-  if (relations != Relations::kPairs && relations != Relations::kCentre) {
-    return bad("relations", static_cast<int>(relations), "kPairs or kCentre");
+  if (relations != Relations::kPairs && relations != Relations::kCentre &&
+      relations != Relations::kBoth) {
+    return bad("relations", static_cast<int>(relations), "a Relations value");
   }
   if (layout != Layout::kConcatenated && layout != Layout::kDistanceJoint &&
       layout != Layout::kFullJoint) {
@@ -151,11 +199,14 @@ absl::StatusOr<LocalFeatures> ExtractLsf(const TriangleMesh& mesh, const LsfOpti
   MESHSEEK_ASSIGN_OR_RETURN(const SurfacePoints centres, SampleSurface(mesh, options.num_points));
   const PointGrid grid(samples.positions, static_cast<float>(s));
 
-  const bool pairs = options.relations == LsfOptions::Relations::kPairs;
+  const bool pairs = options.relations != LsfOptions::Relations::kCentre;
+  const bool centre = options.relations != LsfOptions::Relations::kPairs;
+  const int parts = pairs + centre;
   // Pairs span up to the support's diameter, centre relations its radius.
-  const float inv_span = static_cast<float>(1.0 / (pairs ? 2 * s : s));
+  const float inv_diameter = static_cast<float>(1.0 / (2 * s));
+  const float inv_radius = static_cast<float>(1.0 / s);
   const std::size_t dim = options.Dimension();
-  Histogrammer histogram(options);
+  Histogrammer pair_histogram(options, false), centre_histogram(options, true);
   LocalFeatures features;
   features.dimension = dim;
   features.keypoints.reserve(centres.size());
@@ -172,8 +223,8 @@ absl::StatusOr<LocalFeatures> ExtractLsf(const TriangleMesh& mesh, const LsfOpti
     chosen.resize(m);
     for (std::size_t k = 0; k < m; ++k) chosen[k] = support[k * support.size() / m];
 
-    histogram.Clear();
-    auto relate = [&](const Vec3f& pi, const Vec3f& ni, const Vec3f& pj, const Vec3f& nj) {
+    auto relate = [&](const Vec3f& pi, const Vec3f& ni, const Vec3f& pj, const Vec3f& nj,
+                      float inv_span, Histogrammer& histogram) {
       const Vec3f v = pj - pi;
       const float length = Norm(v);
       if (!(length > 0)) return;  // coincident samples have no direction
@@ -184,20 +235,39 @@ absl::StatusOr<LocalFeatures> ExtractLsf(const TriangleMesh& mesh, const LsfOpti
                     std::fabs(Dot(nj, u)));
     };
     if (pairs) {
+      pair_histogram.Clear();
       for (std::size_t a = 0; a < m; ++a) {
         const Vec3f& pa = samples.positions[chosen[a]];
         const Vec3f& na = samples.normals[chosen[a]];
         for (std::size_t b = a + 1; b < m; ++b) {
-          relate(pa, na, samples.positions[chosen[b]], samples.normals[chosen[b]]);
+          relate(pa,
+                 na,
+                 samples.positions[chosen[b]],
+                 samples.normals[chosen[b]],
+                 inv_diameter,
+                 pair_histogram);
         }
       }
-    } else {
-      for (uint32_t j : chosen) {
-        relate(centres.positions[c], centres.normals[c], samples.positions[j], samples.normals[j]);
-      }
+      pair_histogram.Emit(parts, &features.descriptors);
     }
-    histogram.Emit(&features.descriptors);
-    const Vec3f n = centres.normals[c];
+    Vec3f n = centres.normals[c];
+    if (options.pca_centre_normal) {
+      n = Vec3f(ComputeWeightedPrincipalAxes(samples.positions, support,
+                                             Vec3d(centres.positions[c]), s)
+                    .axes[2]);
+    }
+    if (centre) {
+      centre_histogram.Clear();
+      for (uint32_t j : chosen) {
+        relate(centres.positions[c],
+               n,
+               samples.positions[j],
+               samples.normals[j],
+               inv_radius,
+               centre_histogram);
+      }
+      centre_histogram.Emit(parts, &features.descriptors);
+    }
     features.keypoints.push_back({centres.positions[c], n, Perpendicular(n), static_cast<float>(s), 0});
   }
   if (features.keypoints.empty()) {

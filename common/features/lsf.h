@@ -60,6 +60,8 @@ struct LsfOptions {
     /// The centre sample with each support sample (PPF / spin-image style):
     /// fewer relations, tied to the centre's own normal.
     kCentre = 1,
+    /// Both descriptors concatenated (twice the layout's bytes).
+    kBoth = 2,
   };
   /// How the relations are binned into one descriptor.
   enum class Layout {
@@ -97,13 +99,28 @@ struct LsfOptions {
   Layout layout = Layout::kDistanceJoint;
   /// Bins over d in [0, 1] (uniform).
   int distance_bins = 8;
-  /// Bins over each angle in [0, pi/2] (uniform in angle).
+  /// Bins over each angle in [0, pi/2], uniform in sqrt(1 - |cos|) =
+  /// sqrt(2) sin(angle / 2) (within 10% of uniform in angle, no acos).
   int angle_bins = 8;
+  /// Split each relation linearly between the two nearest bins of every
+  /// coordinate instead of all into one: a support holds only about a hundred
+  /// samples, and hard bin edges turn small sampling differences into
+  /// different bins.
+  bool soft_binning = false;
+  /// The centre's normal for its relations (and the keypoint's view): the
+  /// smallest axis of the support samples' PCA, weighted by (s - distance)
+  /// about the centre (SHOT's frame), instead of the face normal under the
+  /// centre sample: smoother, and the same for a coarse or a fine
+  /// tessellation of the surface.
+  bool pca_centre_normal = false;
   /// Square-root (Hellinger) normalisation before L2.
   bool root = true;
 
   /// Bytes per descriptor that these options give.
   std::size_t Dimension() const;
+  /// Bytes of the pairs' part (centre = false) or the centre's part of the
+  /// descriptor; Dimension() is their sum for kBoth.
+  std::size_t PartDimension(bool centre) const;
   /// InvalidArgument naming the first bad field and its value (also when the
   /// dimension exceeds kMaxDescriptorDimension).
   absl::Status Validate() const;

@@ -78,16 +78,24 @@ TEST(LsfOptionsTest, DefaultsArePinnedAndValid) {
   EXPECT_TRUE(options.Validate().ok());
 }
 
-TEST(LsfOptionsTest, DimensionFollowsTheLayout) {
+TEST(LsfOptionsTest, DimensionFollowsTheLayoutAndRelations) {
   LsfOptions options;
   options.distance_bins = 4;
   options.angle_bins = 6;
+  options.relations = LsfOptions::Relations::kPairs;  // both line angles pooled
   options.layout = LsfOptions::Layout::kConcatenated;
   EXPECT_EQ(options.Dimension(), 4u + 2 * 6);
   options.layout = LsfOptions::Layout::kDistanceJoint;
   EXPECT_EQ(options.Dimension(), 2u * 4 * 6);
   options.layout = LsfOptions::Layout::kFullJoint;
   EXPECT_EQ(options.Dimension(), 4u * 6 * 6 * 6);
+  options.relations = LsfOptions::Relations::kCentre;  // the centre's and the sample's apart
+  options.layout = LsfOptions::Layout::kConcatenated;
+  EXPECT_EQ(options.Dimension(), 4u + 3 * 6);
+  options.layout = LsfOptions::Layout::kDistanceJoint;
+  EXPECT_EQ(options.Dimension(), 3u * 4 * 6);
+  options.relations = LsfOptions::Relations::kBoth;
+  EXPECT_EQ(options.Dimension(), 2u * 4 * 6 + 3u * 4 * 6);
 }
 
 TEST(LsfOptionsTest, RejectsBadValuesWithTheirValue) {
