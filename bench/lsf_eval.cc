@@ -31,6 +31,7 @@ ABSL_FLAG(int, threads, 2, "threads (extraction runs one model per thread)");
 ABSL_FLAG(uint64_t, seed, 0, "k-means seed");
 ABSL_FLAG(int, num_points, meshseek::LsfOptions().num_points, "feature centres per model");
 ABSL_FLAG(double, scale, meshseek::LsfOptions().scale, "support radius / enclosing-sphere radius");
+ABSL_FLAG(std::string, extra_scales, "", "comma-separated further support radii / R");
 ABSL_FLAG(int, samples_per_support, meshseek::LsfOptions().samples_per_support,
           "oriented samples in a flat disc of radius s");
 ABSL_FLAG(int, min_samples, meshseek::LsfOptions().min_samples, "lower bound on samples");
@@ -74,6 +75,12 @@ absl::StatusOr<LsfOptions> OptionsFromFlags() {
   o.angle_bins = absl::GetFlag(FLAGS_angle_bins);
   o.root = absl::GetFlag(FLAGS_root);
   o.soft_binning = absl::GetFlag(FLAGS_soft_binning);
+  for (absl::string_view part :
+       absl::StrSplit(absl::GetFlag(FLAGS_extra_scales), ',', absl::SkipEmpty())) {
+    double v = 0;
+    if (!absl::SimpleAtod(part, &v)) return absl::InvalidArgumentError("bad --extra_scales");
+    o.extra_scales.push_back(v);
+  }
   o.pca_centre_normal = absl::GetFlag(FLAGS_pca_centre_normal);
   const std::string relations = absl::GetFlag(FLAGS_relations);
   if (relations == "pairs") {

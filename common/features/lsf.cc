@@ -157,6 +157,10 @@ absl::Status LsfOptions::Validate() const {
   };
   if (num_points < 1 || num_points > 1000000) return bad("num_points", num_points, "in [1, 1000000]");
   if (!(scale > 0) || scale > 2) return bad("scale", scale, "in (0, 2]");
+  if (extra_scales.size() > 8) return bad("extra_scales count", extra_scales.size(), "at most 8");
+  for (double extra : extra_scales) {
+    if (!(extra > 0) || extra > 2) return bad("extra_scales entry", extra, "in (0, 2]");
+  }
   if (samples_per_support < 4) return bad("samples_per_support", samples_per_support, ">= 4");
   if (min_samples < 16) return bad("min_samples", min_samples, ">= 16");
   if (max_samples < min_samples || max_samples > 10000000) {
@@ -183,35 +187,36 @@ absl::Status LsfOptions::Validate() const {
   return absl::OkStatus();
 }
 
-absl::StatusOr<LocalFeatures> ExtractLsf(const TriangleMesh& mesh, const LsfOptions& options) {
-  MESHSEEK_RETURN_IF_ERROR(options.Validate());
-  MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));
-  MESHSEEK_ASSIGN_OR_RETURN(const Sphere sphere, MinimumEnclosingSphere(mesh));
-  const double s = options.scale * sphere.radius;
-  if (!(s > 0)) {
-    return absl::InvalidArgumentError("model has zero extent (all vertices coincide)");
-  }
-  const double area = SurfaceArea(mesh);
-  const double wanted = options.samples_per_support * area / (M_PI * s * s);
-  const int64_t count = static_cast<int64_t>(
-      std::clamp<double>(std::ceil(wanted), options.min_samples, options.max_samples));
-  MESHSEEK_ASSIGN_OR_RETURN(const SurfacePoints samples, SampleSurface(mesh, count));
-  MESHSEEK_ASSIGN_OR_RETURN(const SurfacePoints centres, SampleSurface(mesh, options.num_points));
-  const PointGrid grid(samples.positions, static_cast<float>(s));
+namespace {
 
+// The features of every centre at support radius s, appended to `features`
+// (keypoint level `level`).
+void DescribeAtRadius(const LsfOptions& options,
+                      const SurfacePoints& samples,
+                      const SurfacePoints& centres,
+                      double s,
+                      int level,
+                      LocalFeatures* features) {
+  const PointGrid grid(samples.positions, static_cast<float>(s));
   const bool pairs = options.relations != LsfOptions::Relations::kCentre;
   const bool centre = options.relations != LsfOptions::Relations::kPairs;
   const int parts = pairs + centre;
   // Pairs span up to the support's diameter, centre relations its radius.
   const float inv_diameter = static_cast<float>(1.0 / (2 * s));
   const float inv_radius = static_cast<float>(1.0 / s);
-  const std::size_t dim = options.Dimension();
   Histogrammer pair_histogram(options, false), centre_histogram(options, true);
-  LocalFeatures features;
-  features.dimension = dim;
-  features.keypoints.reserve(centres.size());
-  features.descriptors.reserve(centres.size() * dim);
   std::vector<uint32_t> support, chosen;
+  auto relate = [](const Vec3f& pi, const Vec3f& ni, const Vec3f& pj, const Vec3f& nj,
+                   float inv_span, Histogrammer& histogram) {
+    const Vec3f v = pj - pi;
+    const float length = Norm(v);
+    if (!(length > 0)) return;  // coincident samples have no direction
+    const Vec3f u = v * (1.0f / length);
+    histogram.Add(std::min(1.0f, length * inv_span),
+                  std::fabs(Dot(ni, nj)),
+                  std::fabs(Dot(ni, u)),
+                  std::fabs(Dot(nj, u)));
+  };
   for (std::size_t c = 0; c < centres.size(); ++c) {
     support.clear();
     grid.RadiusQuery(centres.positions[c], static_cast<float>(s), &support);
@@ -223,17 +228,6 @@ absl::StatusOr<LocalFeatures> ExtractLsf(const TriangleMesh& mesh, const LsfOpti
     chosen.resize(m);
     for (std::size_t k = 0; k < m; ++k) chosen[k] = support[k * support.size() / m];
 
-    auto relate = [&](const Vec3f& pi, const Vec3f& ni, const Vec3f& pj, const Vec3f& nj,
-                      float inv_span, Histogrammer& histogram) {
-      const Vec3f v = pj - pi;
-      const float length = Norm(v);
-      if (!(length > 0)) return;  // coincident samples have no direction
-      const Vec3f u = v * (1.0f / length);
-      histogram.Add(std::min(1.0f, length * inv_span),
-                    std::fabs(Dot(ni, nj)),
-                    std::fabs(Dot(ni, u)),
-                    std::fabs(Dot(nj, u)));
-    };
     if (pairs) {
       pair_histogram.Clear();
       for (std::size_t a = 0; a < m; ++a) {
@@ -248,13 +242,13 @@ absl::StatusOr<LocalFeatures> ExtractLsf(const TriangleMesh& mesh, const LsfOpti
                  pair_histogram);
         }
       }
-      pair_histogram.Emit(parts, &features.descriptors);
+      pair_histogram.Emit(parts, &features->descriptors);
     }
     Vec3f n = centres.normals[c];
     if (options.pca_centre_normal) {
-      n = Vec3f(ComputeWeightedPrincipalAxes(samples.positions, support,
-                                             Vec3d(centres.positions[c]), s)
-                    .axes[2]);
+      n = Vec3f(
+          ComputeWeightedPrincipalAxes(samples.positions, support, Vec3d(centres.positions[c]), s)
+              .axes[2]);
     }
     if (centre) {
       centre_histogram.Clear();
@@ -266,14 +260,46 @@ absl::StatusOr<LocalFeatures> ExtractLsf(const TriangleMesh& mesh, const LsfOpti
                inv_radius,
                centre_histogram);
       }
-      centre_histogram.Emit(parts, &features.descriptors);
+      centre_histogram.Emit(parts, &features->descriptors);
     }
-    features.keypoints.push_back({centres.positions[c], n, Perpendicular(n), static_cast<float>(s), 0});
+    features->keypoints.push_back(
+        {centres.positions[c], n, Perpendicular(n), static_cast<float>(s), level});
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<LocalFeatures> ExtractLsf(const TriangleMesh& mesh, const LsfOptions& options) {
+  MESHSEEK_RETURN_IF_ERROR(options.Validate());
+  MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));
+  MESHSEEK_ASSIGN_OR_RETURN(const Sphere sphere, MinimumEnclosingSphere(mesh));
+  std::vector<double> scales = {options.scale};
+  scales.insert(scales.end(), options.extra_scales.begin(), options.extra_scales.end());
+  const double smallest = *std::min_element(scales.begin(), scales.end()) * sphere.radius;
+  if (!(smallest > 0)) {
+    return absl::InvalidArgumentError("model has zero extent (all vertices coincide)");
+  }
+  // Sample density for the smallest support; larger ones hold more samples
+  // and are strided down to max_support_samples.
+  const double area = SurfaceArea(mesh);
+  const double wanted = options.samples_per_support * area / (M_PI * smallest * smallest);
+  const int64_t count = static_cast<int64_t>(
+      std::clamp<double>(std::ceil(wanted), options.min_samples, options.max_samples));
+  MESHSEEK_ASSIGN_OR_RETURN(const SurfacePoints samples, SampleSurface(mesh, count));
+  MESHSEEK_ASSIGN_OR_RETURN(const SurfacePoints centres, SampleSurface(mesh, options.num_points));
+
+  LocalFeatures features;
+  features.dimension = options.Dimension();
+  features.keypoints.reserve(centres.size() * scales.size());
+  features.descriptors.reserve(centres.size() * scales.size() * features.dimension);
+  for (std::size_t k = 0; k < scales.size(); ++k) {
+    DescribeAtRadius(options, samples, centres, scales[k] * sphere.radius, static_cast<int>(k),
+                     &features);
   }
   if (features.keypoints.empty()) {
     return absl::InvalidArgumentError(absl::StrCat(
         "LSF found no feature centre with at least ", options.min_support_samples,
-        " support samples (", count, " samples, support radius ", s, ")"));
+        " support samples (", count, " samples, smallest support radius ", smallest, ")"));
   }
   return features;
 }

@@ -42,6 +42,7 @@
 #define MESHSEEK_COMMON_FEATURES_LSF_H_
 
 #include <cstddef>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -82,6 +83,11 @@ struct LsfOptions {
   /// Support radius relative to the minimum enclosing sphere's radius R:
   /// s = scale * R. Chosen by the sweep.
   double scale = 0.3;
+  /// Further support radii (relative to R, as scale): every centre also
+  /// gets a feature at each, all in the one set (keypoint level = 1 + the
+  /// index here; the scale's own features have level 0). The codebook then
+  /// holds words of every radius: thin parts and whole limbs at once.
+  std::vector<double> extra_scales;
   /// Target number of oriented samples in a flat disc of radius s; the model
   /// gets this times area / (pi s^2) samples, clamped to
   /// [min_samples, max_samples].
