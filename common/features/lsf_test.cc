@@ -63,18 +63,21 @@ LocalFeatures Extract(const TriangleMesh& mesh, const LsfOptions& options = Test
 TEST(LsfOptionsTest, DefaultsArePinnedAndValid) {
   const LsfOptions options;
   EXPECT_EQ(options.num_points, 1024);
-  EXPECT_DOUBLE_EQ(options.scale, 0.3);
+  EXPECT_DOUBLE_EQ(options.scale, 0.45);
+  EXPECT_TRUE(options.extra_scales.empty());
   EXPECT_EQ(options.samples_per_support, 96);
   EXPECT_EQ(options.min_samples, 2048);
   EXPECT_EQ(options.max_samples, 100000);
   EXPECT_EQ(options.min_support_samples, 8);
   EXPECT_EQ(options.max_support_samples, 192);
-  EXPECT_EQ(options.relations, LsfOptions::Relations::kPairs);
-  EXPECT_EQ(options.layout, LsfOptions::Layout::kDistanceJoint);
-  EXPECT_EQ(options.distance_bins, 8);
-  EXPECT_EQ(options.angle_bins, 8);
+  EXPECT_EQ(options.relations, LsfOptions::Relations::kCentre);
+  EXPECT_EQ(options.layout, LsfOptions::Layout::kFullJoint);
+  EXPECT_EQ(options.distance_bins, 4);
+  EXPECT_EQ(options.angle_bins, 6);
+  EXPECT_TRUE(options.soft_binning);
+  EXPECT_FALSE(options.pca_centre_normal);
   EXPECT_TRUE(options.root);
-  EXPECT_EQ(options.Dimension(), 128u);
+  EXPECT_EQ(options.Dimension(), 864u);
   EXPECT_TRUE(options.Validate().ok());
 }
 
@@ -110,6 +113,7 @@ TEST(LsfOptionsTest, RejectsBadValuesWithTheirValue) {
   EXPECT_EQ(options.Validate().code(), absl::StatusCode::kInvalidArgument);
   options = LsfOptions();
   options.layout = LsfOptions::Layout::kFullJoint;
+  options.distance_bins = 8;
   options.angle_bins = 8;  // 8 x 8^3 = 4096 bytes
   EXPECT_NE(options.Validate().message().find("got 4096"), absl::string_view::npos);
 }
@@ -117,8 +121,8 @@ TEST(LsfOptionsTest, RejectsBadValuesWithTheirValue) {
 TEST(LsfTest, OneFeaturePerCentreOnAClosedSurface) {
   const LocalFeatures features = Extract(LumpyBlob());
   ASSERT_EQ(features.size(), 256u);
-  EXPECT_EQ(features.dimension, 128u);
-  EXPECT_EQ(features.descriptors.size(), 256u * 128);
+  EXPECT_EQ(features.dimension, 864u);
+  EXPECT_EQ(features.descriptors.size(), 256u * 864);
   for (const Keypoint& k : features.keypoints) {
     EXPECT_NEAR(Norm(Vec3d(k.view)), 1.0, 1e-5);
     EXPECT_NEAR(Norm(Vec3d(k.up)), 1.0, 1e-5);
@@ -195,18 +199,34 @@ TEST(LsfTest, IsDeterministic) {
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a.keypoints[i].position, b.keypoints[i].position);
 }
 
-TEST(LsfTest, CentreRelationsAndOtherLayoutsWork) {
+TEST(LsfTest, PairRelationsAndOtherLayoutsWork) {
   LsfOptions options = TestOptions();
-  options.relations = LsfOptions::Relations::kCentre;
+  options.relations = LsfOptions::Relations::kPairs;
+  options.layout = LsfOptions::Layout::kDistanceJoint;
+  options.distance_bins = 8;
+  options.angle_bins = 8;
+  options.max_support_samples = 64;  // pairs cost its square
+  const LocalFeatures pairs = Extract(LumpyBlob(), options);
+  EXPECT_EQ(pairs.dimension, 128u);
+  EXPECT_EQ(pairs.descriptors.size(), pairs.size() * 128);
+  options.relations = LsfOptions::Relations::kBoth;
   options.layout = LsfOptions::Layout::kConcatenated;
-  const LocalFeatures centre = Extract(LumpyBlob(), options);
-  EXPECT_EQ(centre.dimension, options.Dimension());
-  EXPECT_EQ(centre.descriptors.size(), centre.size() * options.Dimension());
-  options.layout = LsfOptions::Layout::kFullJoint;
-  options.distance_bins = 4;
-  options.angle_bins = 4;
-  const LocalFeatures joint = Extract(LumpyBlob(), options);
-  EXPECT_EQ(joint.dimension, 256u);
+  options.soft_binning = false;
+  const LocalFeatures both = Extract(LumpyBlob(), options);
+  EXPECT_EQ(both.dimension, (8u + 2 * 8) + (8u + 3 * 8));
+  EXPECT_EQ(both.descriptors.size(), both.size() * both.dimension);
+}
+
+TEST(LsfTest, ExtraScalesAddOneFeaturePerCentreEach) {
+  LsfOptions options = TestOptions();
+  options.extra_scales = {options.scale * 2};
+  const LocalFeatures features = Extract(LumpyBlob(), options);
+  ASSERT_EQ(features.size(), 512u);
+  EXPECT_EQ(features.keypoints[0].level, 0);
+  EXPECT_EQ(features.keypoints[511].level, 1);
+  EXPECT_NEAR(features.keypoints[511].scale, 2 * features.keypoints[0].scale, 1e-5);
+  options.extra_scales = {3.0};
+  EXPECT_NE(options.Validate().message().find("got 3"), absl::string_view::npos);
 }
 
 TEST(LsfTest, MeshesWithoutAreaAreInvalidArguments) {
