@@ -8,9 +8,10 @@
 //
 // Per model:
 //   1. R = radius of the minimum enclosing sphere; support radius
-//      s = scale * R (as DLD-SIFT's E: scale 1 is the sphere itself).
+//      s = scale * R (as DLD-SIFT's E: scale 1 is the sphere itself), and
+//      each of extra_scales * R: every centre gets one feature per radius.
 //   2. Oriented samples: SampleSurface with its face normals, about
-//      `samples_per_support` samples in a flat disc of radius s (area-uniform,
+//      `samples_per_support` samples in a flat disc of the smallest radius (area-uniform,
 //      Sobol, so independent of tessellation and connectivity: a polygon soup
 //      or a model of many components gives the same samples as the welded
 //      mesh).
@@ -43,16 +44,15 @@
 //      bins stop swamping the rest), L2 normalisation,
 //      bytes = min(255, round(512 v)) as SIFT quantises.
 //
-// Measured on McGill articulated (255 models, V = 1,000, first tier; the
+// Measured on McGill articulated (255 models, first tier = R-precision; the
 // whole sweep is in bench/results/lsf.txt): pairs of support samples 64.1 at
-// the best scale, centre relations 73.6 with the same 2-D (d, angle)
-// histograms at a sixtieth of the time (0.021 s against 0.34 s a model); the
-// joint 4-D histogram 76.8 (concatenated 1-D histograms 74.6, two/three joint
-// 2-D ones 73.6); soft binning 77.5; scale 0.45 (0.3: 70.8, 0.6: 74.0 and
-// 77.3 with the 4-D histogram, 0.8: 72.3); 2,048 centres or 2.7 times denser
-// supports give nothing more (77.3, 77.4); the PCA normal instead of the
-// face normal loses 4.6 (72.9). Extraction: a median 0.027 s a model on one
-// core.
+// their best scale, centre relations 73.6 with the same 2-D (d, angle)
+// histograms at a sixteenth of the time (0.021 s against 0.34 s a model);
+// the joint 4-D histogram 76.8 (concatenated 1-D histograms 74.6, three joint
+// 2-D ones 73.6); soft binning 77.5 (V = 1,000); two radii, 0.3 R and 0.6 R,
+// 78.5 at V = 1,000 and 79.7 at V = 2,000; 2,048 centres or 2.7 times denser
+// supports gave nothing more; the PCA normal instead of the face normal lost
+// 4.6. Extraction of the defaults: a median 0.055 s a model on one core.
 // Deterministic; single-threaded per model (meshseek parallelises across
 // models).
 #ifndef MESHSEEK_COMMON_FEATURES_LSF_H_
@@ -106,15 +106,21 @@ struct LsfOptions {
   /// same (77.3 against 77.5) at twice the time.
   int num_points = 1024;
   /// Support radius relative to the minimum enclosing sphere's radius R:
-  /// s = scale * R. McGill first tier 70.8 / 77.5 / 77.3 at 0.3 / 0.45 /
-  /// 0.6: an articulated limb needs the support to reach past its own
-  /// thickness, and a larger one mixes parts that articulation moves.
-  double scale = 0.45;
+  /// s = scale * R. Alone, McGill first tier (V = 1,000) is 76.6 / 77.5 /
+  /// 77.7 / 77.3 at 0.4 / 0.45 / 0.5 / 0.6 (and 70.8 at 0.3 with 2-D
+  /// histograms, 72.3 at 0.8): an articulated limb needs the support to
+  /// reach past its own thickness, and a larger one mixes parts that
+  /// articulation moves. With extra_scales the small radius adds the
+  /// limbs' own shape to the larger one's context.
+  double scale = 0.3;
   /// Further support radii (relative to R, as scale): every centre also
   /// gets a feature at each, all in the one set (keypoint level = 1 + the
   /// index here; the scale's own features have level 0). The codebook then
   /// holds words of every radius: thin parts and whole limbs at once.
-  std::vector<double> extra_scales;
+  /// {0.6} with scale 0.3: 78.5 at V = 1,000 and 79.7 at V = 2,000, against
+  /// 77.5 and 76.6 for 0.45 alone; three radii (0.25, 0.5, 0.75) measured the
+  /// same (78.3, 79.8) at 1.5 times the features.
+  std::vector<double> extra_scales = {0.6};
   /// Target number of oriented samples in a flat disc of radius s; the model
   /// gets this times area / (pi s^2) samples, clamped to
   /// [min_samples, max_samples]. 256 (with max_support_samples 1,024)

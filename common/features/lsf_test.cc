@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <utility>
+#include <vector>
 
 #include "common/geometry/test_meshes.h"
 #include "common/synth/shapes.h"
@@ -63,8 +64,8 @@ LocalFeatures Extract(const TriangleMesh& mesh, const LsfOptions& options = Test
 TEST(LsfOptionsTest, DefaultsArePinnedAndValid) {
   const LsfOptions options;
   EXPECT_EQ(options.num_points, 1024);
-  EXPECT_DOUBLE_EQ(options.scale, 0.45);
-  EXPECT_TRUE(options.extra_scales.empty());
+  EXPECT_DOUBLE_EQ(options.scale, 0.3);
+  EXPECT_EQ(options.extra_scales, std::vector<double>{0.6});
   EXPECT_EQ(options.samples_per_support, 96);
   EXPECT_EQ(options.min_samples, 2048);
   EXPECT_EQ(options.max_samples, 100000);
@@ -118,17 +119,20 @@ TEST(LsfOptionsTest, RejectsBadValuesWithTheirValue) {
   EXPECT_NE(options.Validate().message().find("got 4096"), absl::string_view::npos);
 }
 
-TEST(LsfTest, OneFeaturePerCentreOnAClosedSurface) {
+TEST(LsfTest, OneFeaturePerCentreAndRadiusOnAClosedSurface) {
   const LocalFeatures features = Extract(LumpyBlob());
-  ASSERT_EQ(features.size(), 256u);
+  ASSERT_EQ(features.size(), 2 * 256u);  // scale and the one extra scale
   EXPECT_EQ(features.dimension, 864u);
-  EXPECT_EQ(features.descriptors.size(), 256u * 864);
+  EXPECT_EQ(features.descriptors.size(), 2 * 256u * 864);
   for (const Keypoint& k : features.keypoints) {
     EXPECT_NEAR(Norm(Vec3d(k.view)), 1.0, 1e-5);
     EXPECT_NEAR(Norm(Vec3d(k.up)), 1.0, 1e-5);
     EXPECT_NEAR(Dot(Vec3d(k.view), Vec3d(k.up)), 0.0, 1e-5);
-    EXPECT_EQ(k.level, 0);
   }
+  // The first 256 at scale (level 0), the next 256 at the extra scale.
+  EXPECT_EQ(features.keypoints[255].level, 0);
+  EXPECT_EQ(features.keypoints[256].level, 1);
+  EXPECT_NEAR(features.keypoints[256].scale, 2 * features.keypoints[0].scale, 1e-5);
   bool differ = false;
   for (std::size_t i = 1; i < features.size() && !differ; ++i) {
     differ = SquaredDistance(features, 0, features, i) > 0;
@@ -180,8 +184,8 @@ TEST(LsfTest, MultiComponentModelsDoNotDependOnComponentOrder) {
   testing_meshes::Append(torus, &ba);
   const LocalFeatures first = Extract(ab);
   const LocalFeatures second = Extract(ba);
-  EXPECT_EQ(first.size(), 256u);
-  EXPECT_EQ(second.size(), 256u);
+  EXPECT_EQ(first.size(), 2 * 256u);
+  EXPECT_EQ(second.size(), 2 * 256u);
   // The sampler visits triangles in file order, so the samples differ; the
   // features must still match feature for feature.
   const double same = MeanNearestDistance(second, first);
