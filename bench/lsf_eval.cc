@@ -11,8 +11,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <numeric>
 #include <cstdio>
+#include <numeric>
 #include <string>
 #include <thread>
 #include <vector>
@@ -32,20 +32,31 @@ ABSL_FLAG(uint64_t, seed, 0, "k-means seed");
 ABSL_FLAG(int, num_points, meshseek::LsfOptions().num_points, "feature centres per model");
 ABSL_FLAG(double, scale, meshseek::LsfOptions().scale, "support radius / enclosing-sphere radius");
 ABSL_FLAG(std::string, extra_scales, "", "comma-separated further support radii / R");
-ABSL_FLAG(int, samples_per_support, meshseek::LsfOptions().samples_per_support,
+ABSL_FLAG(int,
+          samples_per_support,
+          meshseek::LsfOptions().samples_per_support,
           "oriented samples in a flat disc of radius s");
 ABSL_FLAG(int, min_samples, meshseek::LsfOptions().min_samples, "lower bound on samples");
 ABSL_FLAG(int, max_samples, meshseek::LsfOptions().max_samples, "upper bound on samples");
-ABSL_FLAG(int, min_support_samples, meshseek::LsfOptions().min_support_samples,
+ABSL_FLAG(int,
+          min_support_samples,
+          meshseek::LsfOptions().min_support_samples,
           "fewer support samples: no feature");
-ABSL_FLAG(int, max_support_samples, meshseek::LsfOptions().max_support_samples,
+ABSL_FLAG(int,
+          max_support_samples,
+          meshseek::LsfOptions().max_support_samples,
           "support samples entering the relations at most");
 ABSL_FLAG(std::string, relations, "default", "pairs, centre or both");
 ABSL_FLAG(std::string, layout, "default", "concatenated, distance_joint or full_joint");
 ABSL_FLAG(int, distance_bins, meshseek::LsfOptions().distance_bins, "bins over distance");
 ABSL_FLAG(int, angle_bins, meshseek::LsfOptions().angle_bins, "bins over each angle");
-ABSL_FLAG(bool, soft_binning, meshseek::LsfOptions().soft_binning, "linear interpolation between bins");
-ABSL_FLAG(bool, pca_centre_normal, meshseek::LsfOptions().pca_centre_normal,
+ABSL_FLAG(bool,
+          soft_binning,
+          meshseek::LsfOptions().soft_binning,
+          "linear interpolation between bins");
+ABSL_FLAG(bool,
+          pca_centre_normal,
+          meshseek::LsfOptions().pca_centre_normal,
           "centre normal from the support's weighted PCA");
 ABSL_FLAG(bool, root, meshseek::LsfOptions().root, "square-root (Hellinger) normalisation");
 
@@ -90,7 +101,8 @@ absl::StatusOr<LsfOptions> OptionsFromFlags() {
   } else if (relations == "both") {
     o.relations = LsfOptions::Relations::kBoth;
   } else if (relations != "default") {
-    return absl::InvalidArgumentError("--relations must be pairs, centre or both, got " + relations);
+    return absl::InvalidArgumentError("--relations must be pairs, centre or both, got " +
+                                      relations);
   }
   const std::string layout = absl::GetFlag(FLAGS_layout);
   if (layout == "concatenated") {
@@ -115,8 +127,8 @@ int Run() {
   auto models = ReadManifest(absl::GetFlag(FLAGS_manifest));
   auto options = OptionsFromFlags();
   if (!models.ok() || !options.ok()) {
-    std::fprintf(stderr, "%s %s\n", models.status().ToString().c_str(),
-                 options.status().ToString().c_str());
+    std::fprintf(
+        stderr, "%s %s\n", models.status().ToString().c_str(), options.status().ToString().c_str());
     return 2;
   }
   std::vector<int> vocabularies;
@@ -136,8 +148,8 @@ int Run() {
   for (std::size_t i = 0; i < n; ++i) {
     auto mesh = ReadMesh((*models)[i].path);
     if (!mesh.ok()) {
-      std::fprintf(stderr, "model %s: %s\n", (*models)[i].id.c_str(),
-                   mesh.status().ToString().c_str());
+      std::fprintf(
+          stderr, "model %s: %s\n", (*models)[i].id.c_str(), mesh.status().ToString().c_str());
       return 1;
     }
     meshes[i] = *std::move(mesh);
@@ -168,20 +180,30 @@ int Run() {
   std::size_t total_features = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (!errors[i].ok()) {
-      std::fprintf(stderr, "model %s (%s): %s\n", (*models)[i].id.c_str(),
-                   (*models)[i].path.c_str(), errors[i].ToString().c_str());
+      std::fprintf(stderr,
+                   "model %s (%s): %s\n",
+                   (*models)[i].id.c_str(),
+                   (*models)[i].path.c_str(),
+                   errors[i].ToString().c_str());
       return 1;
     }
     total_features += features[i].size();
   }
   const std::size_t slowest =
       std::max_element(cpu_seconds.begin(), cpu_seconds.end()) - cpu_seconds.begin();
-  std::printf("%s: %zu models, dim %zu, %.0f features per model; extraction per model on one "
-              "core: median %.3f s, mean %.3f s, max %.3f s (%s); wall %.1f s on %d threads\n",
-              absl::GetFlag(FLAGS_manifest).c_str(), n, options->Dimension(),
-              static_cast<double>(total_features) / n, Median(cpu_seconds),
-              std::accumulate(cpu_seconds.begin(), cpu_seconds.end(), 0.0) / n,
-              cpu_seconds[slowest], (*models)[slowest].id.c_str(), extract_wall, threads);
+  std::printf(
+      "%s: %zu models, dim %zu, %.0f features per model; extraction per model on one "
+      "core: median %.3f s, mean %.3f s, max %.3f s (%s); wall %.1f s on %d threads\n",
+      absl::GetFlag(FLAGS_manifest).c_str(),
+      n,
+      options->Dimension(),
+      static_cast<double>(total_features) / n,
+      Median(cpu_seconds),
+      std::accumulate(cpu_seconds.begin(), cpu_seconds.end(), 0.0) / n,
+      cpu_seconds[slowest],
+      (*models)[slowest].id.c_str(),
+      extract_wall,
+      threads);
 
   std::vector<std::string> labels;
   for (const auto& m : *models) labels.push_back(m.label);
@@ -207,10 +229,18 @@ int Run() {
       return 1;
     }
     const RetrievalScores& m = metrics->micro;
-    std::printf("  V %5d  NN %.1f  FT %.1f  ST %.1f  E %.1f  DCG %.1f  (macro FT %.1f)  "
-                "codebook %.1f s, all %.1f s\n",
-                v, 100 * m.nn, 100 * m.first_tier, 100 * m.second_tier, 100 * m.e_measure,
-                100 * m.dcg, 100 * metrics->macro.first_tier, codebook_s, Since(start));
+    std::printf(
+        "  V %5d  NN %.1f  FT %.1f  ST %.1f  E %.1f  DCG %.1f  (macro FT %.1f)  "
+        "codebook %.1f s, all %.1f s\n",
+        v,
+        100 * m.nn,
+        100 * m.first_tier,
+        100 * m.second_tier,
+        100 * m.e_measure,
+        100 * m.dcg,
+        100 * metrics->macro.first_tier,
+        codebook_s,
+        Since(start));
     std::fflush(stdout);
   }
   return 0;

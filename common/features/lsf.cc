@@ -37,7 +37,9 @@ BinWeights Spread(float x, int bins, bool soft) {
 // [0, pi/2]: sqrt(1 - c) = sqrt(2) sin(theta / 2), within 10% of theta / (pi/2)
 // and linear near 0 where most normal pairs of a smooth surface lie, at the
 // cost of one square root instead of an acos per relation.
-float AngleCoordinate(float abs_cos) { return std::sqrt(std::max(0.0f, 1.0f - std::min(1.0f, abs_cos))); }
+float AngleCoordinate(float abs_cos) {
+  return std::sqrt(std::max(0.0f, 1.0f - std::min(1.0f, abs_cos)));
+}
 
 // Any unit vector normal to unit n (the keypoint's image up axis is not used
 // by LSF, but Keypoint promises one).
@@ -155,7 +157,8 @@ absl::Status LsfOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("LSF ", field, " must be ", want, ", got ", value));
   };
-  if (num_points < 1 || num_points > 1000000) return bad("num_points", num_points, "in [1, 1000000]");
+  if (num_points < 1 || num_points > 1000000)
+    return bad("num_points", num_points, "in [1, 1000000]");
   if (!(scale > 0) || scale > 2) return bad("scale", scale, "in (0, 2]");
   if (extra_scales.size() > 8) return bad("extra_scales count", extra_scales.size(), "at most 8");
   for (double extra : extra_scales) {
@@ -178,10 +181,12 @@ absl::Status LsfOptions::Validate() const {
       layout != Layout::kFullJoint) {
     return bad("layout", static_cast<int>(layout), "a Layout value");
   }
-  if (distance_bins < 1 || distance_bins > 64) return bad("distance_bins", distance_bins, "in [1, 64]");
+  if (distance_bins < 1 || distance_bins > 64)
+    return bad("distance_bins", distance_bins, "in [1, 64]");
   if (angle_bins < 1 || angle_bins > 64) return bad("angle_bins", angle_bins, "in [1, 64]");
   if (Dimension() > kMaxDescriptorDimension) {
-    return bad("descriptor dimension", Dimension(),
+    return bad("descriptor dimension",
+               Dimension(),
                absl::StrCat("at most ", kMaxDescriptorDimension, " (fewer bins)").c_str());
   }
   return absl::OkStatus();
@@ -206,8 +211,12 @@ void DescribeAtRadius(const LsfOptions& options,
   const float inv_radius = static_cast<float>(1.0 / s);
   Histogrammer pair_histogram(options, false), centre_histogram(options, true);
   std::vector<uint32_t> support, chosen;
-  auto relate = [](const Vec3f& pi, const Vec3f& ni, const Vec3f& pj, const Vec3f& nj,
-                   float inv_span, Histogrammer& histogram) {
+  auto relate = [](const Vec3f& pi,
+                   const Vec3f& ni,
+                   const Vec3f& pj,
+                   const Vec3f& nj,
+                   float inv_span,
+                   Histogrammer& histogram) {
     const Vec3f v = pj - pi;
     const float length = Norm(v);
     if (!(length > 0)) return;  // coincident samples have no direction
@@ -293,13 +302,17 @@ absl::StatusOr<LocalFeatures> ExtractLsf(const TriangleMesh& mesh, const LsfOpti
   features.keypoints.reserve(centres.size() * scales.size());
   features.descriptors.reserve(centres.size() * scales.size() * features.dimension);
   for (std::size_t k = 0; k < scales.size(); ++k) {
-    DescribeAtRadius(options, samples, centres, scales[k] * sphere.radius, static_cast<int>(k),
-                     &features);
+    DescribeAtRadius(
+        options, samples, centres, scales[k] * sphere.radius, static_cast<int>(k), &features);
   }
   if (features.keypoints.empty()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "LSF found no feature centre with at least ", options.min_support_samples,
-        " support samples (", count, " samples, smallest support radius ", smallest, ")"));
+    return absl::InvalidArgumentError(absl::StrCat("LSF found no feature centre with at least ",
+                                                   options.min_support_samples,
+                                                   " support samples (",
+                                                   count,
+                                                   " samples, smallest support radius ",
+                                                   smallest,
+                                                   ")"));
   }
   return features;
 }

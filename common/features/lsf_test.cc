@@ -31,7 +31,10 @@ LsfOptions TestOptions() {
   return options;
 }
 
-double SquaredDistance(const LocalFeatures& a, std::size_t i, const LocalFeatures& b, std::size_t j) {
+double SquaredDistance(const LocalFeatures& a,
+                       std::size_t i,
+                       const LocalFeatures& b,
+                       std::size_t j) {
   double sum = 0;
   for (std::size_t k = 0; k < a.dimension; ++k) {
     const double d = double(a.descriptor(i)[k]) - b.descriptor(j)[k];
@@ -149,9 +152,11 @@ TEST(LsfTest, InvariantToRotationScaleAndTranslation) {
   const LocalFeatures torus = Extract(MakeTorus(1.0, 0.35, 48, 24));
   const LocalFeatures box = Extract(MakeBox({2.0, 1.2, 0.8}, 0.1));
   const double same = MeanNearestDistance(copy, original);
-  const double other = std::min(MeanNearestDistance(torus, original), MeanNearestDistance(box, original));
+  const double other =
+      std::min(MeanNearestDistance(torus, original), MeanNearestDistance(box, original));
   std::printf("LSF nearest-descriptor distance: moved copy %.2f, other shapes %.2f (bytes, L2)\n",
-              same, other);
+              same,
+              other);
   EXPECT_LT(same, 0.2 * other);
 }
 
@@ -190,7 +195,8 @@ TEST(LsfTest, MultiComponentModelsDoNotDependOnComponentOrder) {
   // features must still match feature for feature.
   const double same = MeanNearestDistance(second, first);
   const double other = MeanNearestDistance(Extract(MakeBox({2.0, 1.2, 0.8}, 0.1)), first);
-  std::printf("LSF nearest-descriptor distance: reordered components %.2f, box %.2f\n", same, other);
+  std::printf(
+      "LSF nearest-descriptor distance: reordered components %.2f, box %.2f\n", same, other);
   EXPECT_LT(same, 0.5 * other);
 }
 
@@ -200,7 +206,8 @@ TEST(LsfTest, IsDeterministic) {
   const LocalFeatures b = Extract(mesh);
   EXPECT_EQ(a.descriptors, b.descriptors);
   ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a.keypoints[i].position, b.keypoints[i].position);
+  for (std::size_t i = 0; i < a.size(); ++i)
+    EXPECT_EQ(a.keypoints[i].position, b.keypoints[i].position);
 }
 
 TEST(LsfTest, PairRelationsAndOtherLayoutsWork) {
@@ -239,8 +246,7 @@ TEST(LsfTest, MeshesWithoutAreaAreInvalidArguments) {
   flat.triangles = {{0, 1, 2}, {0, 0, 1}};
   auto features = ExtractLsf(flat, TestOptions());
   EXPECT_EQ(features.status().code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_NE(features.status().message().find("area"), absl::string_view::npos)
-      << features.status();
+  EXPECT_NE(features.status().message().find("area"), absl::string_view::npos) << features.status();
   EXPECT_EQ(ExtractLsf(TriangleMesh{}, TestOptions()).status().code(),
             absl::StatusCode::kInvalidArgument);
   LsfOptions bad = TestOptions();
