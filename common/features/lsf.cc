@@ -22,13 +22,12 @@ struct BinWeights {
   float weight[2];
 };
 BinWeights Spread(float x, int bins, bool soft) {
-  if (!soft) {
+  if (!soft || bins == 1) {
     const int b = std::min(bins - 1, static_cast<int>(x * bins));
     return {{b, b}, {1.0f, 0.0f}};
   }
   const float u = std::clamp(x * bins - 0.5f, 0.0f, static_cast<float>(bins - 1));
   const int b = std::min(bins - 2, static_cast<int>(u));
-  if (bins == 1) return {{0, 0}, {1.0f, 0.0f}};
   const float f = u - b;
   return {{b, b + 1}, {1.0f - f, f}};
 }
