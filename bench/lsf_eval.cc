@@ -20,6 +20,7 @@
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/strings/numbers.h"
+#include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "common/features/lsf.h"
 #include "common/geometry/mesh_io.h"
@@ -31,7 +32,10 @@ ABSL_FLAG(int, threads, 2, "threads (extraction runs one model per thread)");
 ABSL_FLAG(uint64_t, seed, 0, "k-means seed");
 ABSL_FLAG(int, num_points, meshseek::LsfOptions().num_points, "feature centres per model");
 ABSL_FLAG(double, scale, meshseek::LsfOptions().scale, "support radius / enclosing-sphere radius");
-ABSL_FLAG(std::string, extra_scales, "", "comma-separated further support radii / R");
+ABSL_FLAG(std::string,
+          extra_scales,
+          absl::StrJoin(meshseek::LsfOptions().extra_scales, ","),
+          "comma-separated further support radii / R; replaces the default list (empty: none)");
 ABSL_FLAG(int,
           samples_per_support,
           meshseek::LsfOptions().samples_per_support,
@@ -86,6 +90,7 @@ absl::StatusOr<LsfOptions> OptionsFromFlags() {
   o.angle_bins = absl::GetFlag(FLAGS_angle_bins);
   o.root = absl::GetFlag(FLAGS_root);
   o.soft_binning = absl::GetFlag(FLAGS_soft_binning);
+  o.extra_scales.clear();
   for (absl::string_view part :
        absl::StrSplit(absl::GetFlag(FLAGS_extra_scales), ',', absl::SkipEmpty())) {
     double v = 0;
