@@ -33,6 +33,12 @@ absl::StatusOr<LocalFeatures> ExtractBf(const TriangleMesh& mesh,
   return ExtractBfDsift(mesh, options.bfdsift);
 }
 
+absl::StatusOr<LocalFeatures> ExtractLocalStatistics(const TriangleMesh& mesh,
+                                                     const ExtractorOptions& options,
+                                                     const PointGraph*) {
+  return ExtractLsf(mesh, options.lsf);
+}
+
 absl::StatusOr<LocalFeatures> ExtractLightField(const TriangleMesh& mesh,
                                                 const ExtractorOptions& options,
                                                 const PointGraph*) {
@@ -61,6 +67,10 @@ const std::vector<FeatureMethodInfo>& FeatureMethods() {
        "BF-DSIFT (Furuya & Ohbuchi): dense SIFT on depth views of the whole model",
        DescriptorKind::kBagOfFeatures, 8000,
        [](const ExtractorOptions& o) { return o.bfdsift.Validate(); }, ExtractBf},
+      {FeatureMethod::kLsf, "lsf",
+       "LSF: joint histograms of distance and normal angles about dense surface samples",
+       DescriptorKind::kBagOfFeatures, 2000,
+       [](const ExtractorOptions& o) { return o.lsf.Validate(); }, ExtractLocalStatistics},
       {FeatureMethod::kLfd, "lfd",
        "LFD (Chen et al.): Zernike and Fourier silhouette descriptors of 10 light fields",
        DescriptorKind::kGlobal, 0, [](const ExtractorOptions& o) { return o.lfd.Validate(); },

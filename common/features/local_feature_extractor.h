@@ -15,6 +15,7 @@
 #include "common/features/bf_dsift.h"
 #include "common/features/dld_sift.h"
 #include "common/features/ld_sift.h"
+#include "common/features/lsf.h"
 #include "common/features/local_features.h"
 #include "common/features/rld_sift.h"
 #include "common/global/lfd.h"
@@ -22,7 +23,7 @@
 
 namespace meshseek {
 
-enum class FeatureMethod { kDldSift, kLdSift, kRldSift, kBfDsift, kLfd };
+enum class FeatureMethod { kDldSift, kLdSift, kRldSift, kBfDsift, kLsf, kLfd };
 
 // How a method's features become a model's signature: a bag of features over
 // a codebook learnt from the collection (the local methods), or one
@@ -79,6 +80,7 @@ struct ExtractorOptions {
   LdSiftOptions ld;
   RldSiftOptions rld;
   BfDsiftOptions bfdsift;
+  LsfOptions lsf;
   LfdOptions lfd;
 
   /// Validates the options of the selected method.

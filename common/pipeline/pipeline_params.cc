@@ -10,6 +10,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
 #include "common/base/status_macros.h"
 #include "common/search/sparse_histogram.h"
 
@@ -23,11 +24,18 @@ constexpr FeatureMethod kLd = FeatureMethod::kLdSift;
 constexpr FeatureMethod kRld = FeatureMethod::kRldSift;
 constexpr FeatureMethod kBf = FeatureMethod::kBfDsift;
 constexpr FeatureMethod kLfd = FeatureMethod::kLfd;
+constexpr FeatureMethod kLsf = FeatureMethod::kLsf;
 
 // Canonical text of a value: integers in full, doubles shortest round-trip.
 std::string Text(int v) { return absl::StrCat(v); }
 std::string Text(uint64_t v) { return absl::StrCat(v); }
 std::string Text(bool v) { return v ? "true" : "false"; }
+std::string Text(double v);
+std::string Text(const std::vector<double>& v) {
+  std::string out;
+  for (double x : v) absl::StrAppend(&out, out.empty() ? "" : ",", Text(x));
+  return out;
+}
 std::string Text(double v) {
   // Six significant digits when they read back to the same double (every
   // default), all seventeen otherwise.
@@ -48,11 +56,21 @@ template <>
 ParamType TypeOf<double>() { return ParamType::kDouble; }
 template <>
 ParamType TypeOf<bool>() { return ParamType::kBool; }
+template <>
+ParamType TypeOf<std::vector<double>>() { return ParamType::kDoubleList; }
 
 void Parse(absl::string_view text, int* v) { (void)absl::SimpleAtoi(text, v); }
 void Parse(absl::string_view text, uint64_t* v) { (void)absl::SimpleAtoi(text, v); }
 void Parse(absl::string_view text, double* v) { (void)absl::SimpleAtod(text, v); }
 void Parse(absl::string_view text, bool* v) { *v = text == "true"; }
+void Parse(absl::string_view text, std::vector<double>* v) {
+  v->clear();
+  for (absl::string_view part : absl::StrSplit(text, ',', absl::SkipEmpty())) {
+    double x = 0;
+    (void)absl::SimpleAtod(part, &x);
+    v->push_back(x);
+  }
+}
 
 // A parameter stored in one field of the selected method's options: `field`
 // returns that field (it may look at options.extractor.method).
@@ -142,9 +160,28 @@ std::vector<ParamSpec> MakeSpecs() {
   const Scope listed = Scope::kListed;
   specs.push_back(Field<double>(
       "scale", "support radius E relative to the minimum enclosing sphere (s = E * D / 2)", 1e-6, 2,
-      listed, {kDld}, +[](Options& o) -> double& { return o.extractor.dld.scale; }));
-  specs.push_back(Field<int>("points", "feature points per model (N_DLD)", 1, 1000000, listed,
-                             {kDld}, +[](Options& o) -> int& { return o.extractor.dld.num_points; }));
+      listed, {kDld, kLsf}, +[](Options& o) -> double& {
+        return o.extractor.method == kLsf ? o.extractor.lsf.scale : o.extractor.dld.scale;
+      }));
+  specs.push_back(Field<int>("points", "feature points per model (N_DLD, LSF's centres)", 1,
+                             1000000, listed, {kDld, kLsf}, +[](Options& o) -> int& {
+                               return o.extractor.method == kLsf ? o.extractor.lsf.num_points
+                                                                 : o.extractor.dld.num_points;
+                             }));
+  specs.push_back(Field<std::vector<double>>(
+      "extra_scales", "further support radii (as scale), every centre described at each", 1e-6, 2,
+      listed, {kLsf},
+      +[](Options& o) -> std::vector<double>& { return o.extractor.lsf.extra_scales; }));
+  specs.push_back(Field<int>(
+      "samples_per_support", "oriented surface samples in a flat disc of the support radius", 8,
+      100000, listed, {kLsf},
+      +[](Options& o) -> int& { return o.extractor.lsf.samples_per_support; }));
+  specs.push_back(Field<int>("distance_bins", "histogram bins over the distance to the centre", 1,
+                             64, listed, {kLsf},
+                             +[](Options& o) -> int& { return o.extractor.lsf.distance_bins; }));
+  specs.push_back(Field<int>("angle_bins", "histogram bins over each normal angle", 1, 64, listed,
+                             {kLsf},
+                             +[](Options& o) -> int& { return o.extractor.lsf.angle_bins; }));
   specs.push_back(Field<int>(
       "frame_samples", "dense surface samples per support disc for the local PCA frame", 8, 1000000,
       listed, {kDld},
@@ -271,6 +308,17 @@ absl::Status CheckValue(const ParamSpec& spec, absl::string_view text) {
         if (choice == text) return absl::OkStatus();
       }
       return bad();
+    case ParamType::kDoubleList: {
+      int count = 0;
+      for (absl::string_view part : absl::StrSplit(text, ',', absl::SkipEmpty())) {
+        double v;
+        if (++count > 8 || !absl::SimpleAtod(part, &v) || !std::isfinite(v) || v < spec.min ||
+            v > spec.max) {
+          return bad();
+        }
+      }
+      return absl::OkStatus();
+    }
   }
   return bad();
 }
@@ -311,6 +359,8 @@ std::string ParamSpec::TypeDescription() const {
     case ParamType::kDouble: return absl::StrCat("a number in [", Text(min), ", ", Text(max), "]");
     case ParamType::kBool: return "true or false";
     case ParamType::kChoice: return absl::StrCat("one of ", absl::StrJoin(choices, ", "));
+    case ParamType::kDoubleList:
+      return absl::StrCat("up to 8 comma-separated numbers in [", Text(min), ", ", Text(max), "]");
   }
   return "?";
 }
@@ -390,6 +440,13 @@ Json PipelineParamsToJson(const RetrievalPipelineOptions& options) {
       }
       case ParamType::kBool: json.Set(spec.name, text == "true"); break;
       case ParamType::kChoice: json.Set(spec.name, text); break;
+      case ParamType::kDoubleList: {
+        Json& list = json.Set(spec.name, Json::MakeArray());
+        std::vector<double> values;
+        Parse(text, &values);
+        for (double v : values) list.Push(v);
+        break;
+      }
     }
   }
   return json;

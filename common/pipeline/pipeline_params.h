@@ -30,7 +30,7 @@
 
 namespace meshseek {
 
-enum class ParamType { kInt, kUint64, kDouble, kBool, kChoice };
+enum class ParamType { kInt, kUint64, kDouble, kBool, kChoice, kDoubleList };
 
 struct ParamSpec {
   /// Flag, JSON and PipelineParams key: lower_snake_case.
@@ -38,7 +38,8 @@ struct ParamSpec {
   ParamType type = ParamType::kInt;
   /// One line for --help; says what the value means and its unit.
   std::string doc;
-  /// Inclusive range of numeric types.
+  /// Inclusive range of numeric types (of each element of a kDoubleList,
+  /// written "0.3,0.6", at most 8, may be empty).
   double min = 0;
   double max = 0;
   /// The accepted values of kChoice.
