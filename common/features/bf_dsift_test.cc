@@ -16,7 +16,7 @@ TEST(BfDsiftOptionsTest, DefaultsArePinnedAndValid) {
   EXPECT_EQ(options.view_level, 1);  // 42 views, the original's
   EXPECT_EQ(options.view_size, 256);
   EXPECT_EQ(options.points_per_view, 300);
-  EXPECT_EQ(options.patch_radius, 0.08);
+  EXPECT_EQ(options.patch_radius, 0.15);
   EXPECT_EQ(options.patch_scales, 1);
   EXPECT_EQ(options.patch_image.image_size, 21);
   EXPECT_EQ(options.descriptor.orientation, ImageOrientation::kDominant);
