@@ -14,10 +14,10 @@ TEST(BfDsiftOptionsTest, DefaultsArePinnedAndValid) {
   const BfDsiftOptions options;
   EXPECT_TRUE(options.Validate().ok());
   EXPECT_EQ(options.view_level, 1);  // 42 views, the original's
-  EXPECT_EQ(options.view_size, 256);
-  EXPECT_EQ(options.points_per_view, 300);
-  EXPECT_EQ(options.patch_radius, 0.15);
-  EXPECT_EQ(options.patch_scales, 1);
+  EXPECT_EQ(options.view_size, 128);
+  EXPECT_EQ(options.points_per_view, 150);
+  EXPECT_EQ(options.patch_radius, 0.05);
+  EXPECT_EQ(options.patch_scales, 3);
   EXPECT_EQ(options.patch_image.image_size, 21);
   EXPECT_EQ(options.descriptor.orientation, ImageOrientation::kDominant);
 }
@@ -38,6 +38,8 @@ BfDsiftOptions Small() {
   options.view_level = 0;
   options.view_size = 128;
   options.points_per_view = 40;
+  options.patch_radius = 0.15;
+  options.patch_scales = 1;
   return options;
 }
 
