@@ -27,6 +27,7 @@
 #include "absl/strings/str_cat.h"
 #include "cli/pipeline_flags.h"
 #include "common/features/local_feature_extractor.h"
+#include "bench/bench_models.h"
 #include "common/geometry/mesh_io.h"
 #include "common/geometry/test_meshes.h"
 
@@ -37,33 +38,8 @@ namespace meshseek {
 namespace {
 
 const std::vector<TriangleMesh>& Models() {
-  static const std::vector<TriangleMesh> meshes = [] {
-    std::vector<TriangleMesh> out;
-    const std::string dir = absl::GetFlag(FLAGS_models_dir);
-    if (dir.empty()) {
-      out.push_back(testing_meshes::Icosphere(5));
-      return out;
-    }
-    std::vector<std::string> paths;
-    for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
-      if (entry.is_regular_file() && MeshFormatFromPath(entry.path().string()).ok()) {
-        paths.push_back(entry.path().string());
-      }
-    }
-    std::sort(paths.begin(), paths.end());
-    if (static_cast<int>(paths.size()) > absl::GetFlag(FLAGS_max_models)) {
-      paths.resize(absl::GetFlag(FLAGS_max_models));
-    }
-    for (const std::string& path : paths) {
-      auto mesh = ReadMesh(path);
-      if (!mesh.ok()) {
-        std::cerr << mesh.status() << "\n";
-        std::exit(1);
-      }
-      out.push_back(*std::move(mesh));
-    }
-    return out;
-  }();
+  static const std::vector<TriangleMesh> meshes =
+      LoadBenchModels(absl::GetFlag(FLAGS_models_dir), absl::GetFlag(FLAGS_max_models));
   return meshes;
 }
 

@@ -24,6 +24,7 @@
 #include "absl/flags/parse.h"
 #include "common/base/cpu_features.h"
 #include "common/geometry/icosphere.h"
+#include "bench/bench_models.h"
 #include "common/geometry/mesh_io.h"
 #include "common/global/lfd.h"
 
@@ -34,33 +35,8 @@ namespace meshseek {
 namespace {
 
 const std::vector<TriangleMesh>& Models() {
-  static const std::vector<TriangleMesh> meshes = [] {
-    std::vector<TriangleMesh> out;
-    const std::string dir = absl::GetFlag(FLAGS_models_dir);
-    if (dir.empty()) {
-      out.push_back(Icosphere(5));
-      return out;
-    }
-    std::vector<std::string> paths;
-    for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
-      if (entry.is_regular_file() && MeshFormatFromPath(entry.path().string()).ok()) {
-        paths.push_back(entry.path().string());
-      }
-    }
-    std::sort(paths.begin(), paths.end());
-    if (static_cast<int>(paths.size()) > absl::GetFlag(FLAGS_max_models)) {
-      paths.resize(absl::GetFlag(FLAGS_max_models));
-    }
-    for (const std::string& path : paths) {
-      auto mesh = ReadMesh(path);
-      if (!mesh.ok()) {
-        std::cerr << mesh.status() << "\n";
-        std::exit(1);
-      }
-      out.push_back(*std::move(mesh));
-    }
-    return out;
-  }();
+  static const std::vector<TriangleMesh> meshes =
+      LoadBenchModels(absl::GetFlag(FLAGS_models_dir), absl::GetFlag(FLAGS_max_models));
   return meshes;
 }
 

@@ -10,15 +10,7 @@
 namespace meshseek {
 namespace {
 
-// A lumpy closed surface with no symmetry.
-TriangleMesh LumpyBlob(int levels = 3) {
-  TriangleMesh mesh = testing_meshes::Icosphere(levels, 1.0f);
-  for (Vec3f& v : mesh.vertices) {
-    const float bump = 1.0f + 0.25f * std::sin(3 * v.x + 1) * std::cos(2 * v.y) + 0.15f * v.z * v.x;
-    v = Vec3f(1.6f * v.x * bump, v.y * bump, 0.7f * v.z * bump);
-  }
-  return mesh;
-}
+using testing_meshes::LumpyBlob;
 
 TEST(DldSiftOptionsTest, DefaultsArePinnedAndValid) {
   const DldSiftOptions options;

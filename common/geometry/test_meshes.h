@@ -77,6 +77,17 @@ inline void Append(const TriangleMesh& part, TriangleMesh* mesh) {
   }
 }
 
+// A lumpy closed surface with no symmetry (an icosphere subdivided `levels`
+// times, bumped and stretched).
+inline TriangleMesh LumpyBlob(int levels = 3) {
+  TriangleMesh mesh = Icosphere(levels, 1.0f);
+  for (Vec3f& v : mesh.vertices) {
+    const float bump = 1.0f + 0.25f * std::sin(3 * v.x + 1) * std::cos(2 * v.y) + 0.15f * v.z * v.x;
+    v = Vec3f(1.6f * v.x * bump, v.y * bump, 0.7f * v.z * bump);
+  }
+  return mesh;
+}
+
 // Rotation matrix (row-major) about a unit axis by `angle` radians.
 inline std::array<double, 9> AxisAngle(Vec3d axis, double angle) {
   axis = Normalized(axis);
