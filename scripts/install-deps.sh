@@ -21,7 +21,7 @@ if [ "${1:-}" != "--build-only" ]; then
     openssl                                          # tests/security_test makes a throwaway CA (deploy/make-certs.sh)
     libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
     libfaiss-dev libopenblas-dev                     # yardsticks of bench/codebook_benchmark (Faiss on OpenBLAS)
-    clang llvm                                       # libFuzzer harnesses (tests/fuzz), llvm-symbolizer for sanitizer reports
+    clang llvm libclang-rt-14-dev                    # libFuzzer harnesses (tests/fuzz; the runtime and sanitizer headers are only recommended by clang), llvm-symbolizer
   )
 fi
 

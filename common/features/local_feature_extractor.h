@@ -15,11 +15,11 @@
 #include "common/features/bf_dsift.h"
 #include "common/features/dld_sift.h"
 #include "common/features/ld_sift.h"
-#include "common/features/lsf.h"
 #include "common/features/local_features.h"
+#include "common/features/lsf.h"
 #include "common/features/rld_sift.h"
-#include "common/global/lfd.h"
 #include "common/geometry/mesh.h"
+#include "common/global/lfd.h"
 
 namespace meshseek {
 
