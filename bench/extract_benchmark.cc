@@ -25,9 +25,9 @@
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/strings/str_cat.h"
+#include "bench/bench_models.h"
 #include "cli/pipeline_flags.h"
 #include "common/features/local_feature_extractor.h"
-#include "bench/bench_models.h"
 #include "common/geometry/mesh_io.h"
 #include "common/geometry/test_meshes.h"
 
@@ -95,10 +95,9 @@ void BM_Extract(benchmark::State& state, FeatureMethod method) {
 // BM_Extract/<name> for every registered method (FeatureMethods()).
 void RegisterMethodBenchmarks() {
   for (const FeatureMethodInfo& info : FeatureMethods()) {
-    benchmark::RegisterBenchmark(absl::StrCat("BM_Extract/", info.name).c_str(),
-                                 [method = info.method](benchmark::State& state) {
-                                   BM_Extract(state, method);
-                                 })
+    benchmark::RegisterBenchmark(
+        absl::StrCat("BM_Extract/", info.name).c_str(),
+        [method = info.method](benchmark::State& state) { BM_Extract(state, method); })
         ->Unit(benchmark::kMillisecond)
         ->Iterations(1);
   }

@@ -353,14 +353,17 @@ absl::Status RunStatus() {
     absl::StrAppend(&params, params.empty() ? "" : " ", v.name(), "=", v.value());
   }
   if (params.empty()) params = info.params().ShortDebugString();  // a legacy collection
-  std::printf("collection %s: %llu models, %llu pending, %llu extracted, %llu failed, %llu indexed; "
-              "index generation '%s'\nparams: %s\n",
-              info.name().c_str(), static_cast<unsigned long long>(info.models()),
-              static_cast<unsigned long long>(info.pending()),
-              static_cast<unsigned long long>(info.extracted()),
-              static_cast<unsigned long long>(info.failed()),
-              static_cast<unsigned long long>(info.indexed()), info.codebook_id().c_str(),
-              params.c_str());
+  std::printf(
+      "collection %s: %llu models, %llu pending, %llu extracted, %llu failed, %llu indexed; "
+      "index generation '%s'\nparams: %s\n",
+      info.name().c_str(),
+      static_cast<unsigned long long>(info.models()),
+      static_cast<unsigned long long>(info.pending()),
+      static_cast<unsigned long long>(info.extracted()),
+      static_cast<unsigned long long>(info.failed()),
+      static_cast<unsigned long long>(info.indexed()),
+      info.codebook_id().c_str(),
+      params.c_str());
   // Every failed model and why, a page at a time.
   v1::ListCollectionModelsRequest list;
   list.set_collection(collection);
@@ -421,7 +424,10 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
       if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
     }
     collection = absl::StrCat(
-        folder.empty() ? "eval" : folder, "-", FeatureMethodName(options.extractor.method), "-",
+        folder.empty() ? "eval" : folder,
+        "-",
+        FeatureMethodName(options.extractor.method),
+        "-",
         absl::Hex(Fnv1a64(params, kFnv1a64OffsetBasis) & 0xffffffffu, absl::kZeroPad8));
   }
   MESHSEEK_RETURN_IF_ERROR(EnsureCollection(stub, collection));

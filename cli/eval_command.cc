@@ -47,19 +47,18 @@ absl::Status RunEval() {
       evaluation.codebook_size > 0
           ? absl::StrCat("codebook V = ", evaluation.codebook_size)
           : absl::StrCat("global descriptors of ", FeatureMethodName(options.extractor.method));
-  std::printf(
-      EvalInProcess()
-          ? "%zu models, %s; time %.1f s (extract %.1f, codebook %.1f, encode %.1f, "
-            "rank %.1f)\n"
-          : "%zu models, %s; time %.1f s (ingest+extract %.1f, codebook+encode+index "
-            "%.1f, -, distances+metrics %.1f)\n",
-      evaluation.models.size(),
-      signature.c_str(),
-      t.total_seconds,
-      t.extract_seconds,
-      t.codebook_seconds,
-      t.encode_seconds,
-      t.rank_seconds);
+  std::printf(EvalInProcess()
+                  ? "%zu models, %s; time %.1f s (extract %.1f, codebook %.1f, encode %.1f, "
+                    "rank %.1f)\n"
+                  : "%zu models, %s; time %.1f s (ingest+extract %.1f, codebook+encode+index "
+                    "%.1f, -, distances+metrics %.1f)\n",
+              evaluation.models.size(),
+              signature.c_str(),
+              t.total_seconds,
+              t.extract_seconds,
+              t.codebook_seconds,
+              t.encode_seconds,
+              t.rank_seconds);
   std::printf("wrote %s/distances.bin and %s/metrics.json\n", out_dir.c_str(), out_dir.c_str());
   return absl::OkStatus();
 }

@@ -28,13 +28,13 @@
 #include "common/base/status_macros.h"
 #include "common/features/depth_image.h"
 #include "common/geometry/enclosing_sphere.h"
+#include "common/geometry/icosphere.h"
 #include "common/geometry/mesh_io.h"
-#include "common/rpc/mesh_limit_flags.h"
 #include "common/geometry/principal_axes.h"
 #include "common/geometry/triangle_bvh.h"
-#include "common/geometry/icosphere.h"
 #include "common/global/lfd_cameras.h"
 #include "common/render/view_renderer.h"
+#include "common/rpc/mesh_limit_flags.h"
 
 ABSL_DECLARE_FLAG(std::string, out);
 ABSL_FLAG(int, montage_images, 48, "inspect: depth images in the montage");
@@ -165,8 +165,10 @@ absl::Status WriteMontage(const std::string& path,
 
 // The whole-model views of bfdsift (depth, with the points sampled in each)
 // and lfd (the first light field's silhouettes), side by side.
-absl::Status WriteViews(const std::string& path, const TriangleMesh& mesh,
-                        const RetrievalPipelineOptions& options, const LocalFeatures& features) {
+absl::Status WriteViews(const std::string& path,
+                        const TriangleMesh& mesh,
+                        const RetrievalPipelineOptions& options,
+                        const LocalFeatures& features) {
   const bool lfd = options.extractor.method == FeatureMethod::kLfd;
   ViewRenderOptions render;
   render.image_size = lfd ? options.extractor.lfd.image_size : options.extractor.bfdsift.view_size;
@@ -186,8 +188,9 @@ absl::Status WriteViews(const std::string& path, const TriangleMesh& mesh,
     cv::Mat image(n, n, CV_8UC3);
     for (int y = 0; y < n; ++y) {
       for (int x = 0; x < n; ++x) {
-        const uint8_t g = lfd ? (view.Covered(x, y) ? 0 : 255)
-                              : static_cast<uint8_t>(view.Covered(x, y) ? 40 + 215 * view.DepthAt(x, y) : 0);
+        const uint8_t g =
+            lfd ? (view.Covered(x, y) ? 0 : 255)
+                : static_cast<uint8_t>(view.Covered(x, y) ? 40 + 215 * view.DepthAt(x, y) : 0);
         image.at<cv::Vec3b>(y, x) = cv::Vec3b(g, g, g);
       }
     }
@@ -204,9 +207,12 @@ absl::Status WriteViews(const std::string& path, const TriangleMesh& mesh,
       }
     }
     image.copyTo(montage(cv::Rect(static_cast<int>(v % columns) * (n + 4) + 2,
-                                  static_cast<int>(v / columns) * (n + 4) + 2, n, n)));
+                                  static_cast<int>(v / columns) * (n + 4) + 2,
+                                  n,
+                                  n)));
   }
-  if (!cv::imwrite(path, montage)) return absl::PermissionDeniedError(absl::StrCat(path, ": cannot write"));
+  if (!cv::imwrite(path, montage))
+    return absl::PermissionDeniedError(absl::StrCat(path, ": cannot write"));
   return absl::OkStatus();
 }
 
@@ -228,8 +234,12 @@ absl::Status RunInspect(const std::string& model_path) {
   if (method == FeatureMethod::kBfDsift || method == FeatureMethod::kLfd) {
     MESHSEEK_RETURN_IF_ERROR(WriteViews(out_dir + "/views.png", mesh, options, features));
     std::printf("%s: %s\n%s: %zu features (%zu bytes each)\nwrote %s/views.png\n",
-                model_path.c_str(), report.Summary().c_str(), FeatureMethodName(method),
-                features.size(), features.dimension, out_dir.c_str());
+                model_path.c_str(),
+                report.Summary().c_str(),
+                FeatureMethodName(method),
+                features.size(),
+                features.dimension,
+                out_dir.c_str());
     return absl::OkStatus();
   }
   MESHSEEK_RETURN_IF_ERROR(WritePointsPly(out_dir + "/points.ply", features));

@@ -130,11 +130,11 @@ TEST_F(EndToEndTest, EveryMethodRunsThroughTheCliWithTheSameOutputs) {
   for (const std::string method : {"ld", "rld"}) {
     const std::string out = *dir_ + "/eval_" + method;
     std::string output;
-    const int code =
-        RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --progress=false --manifest " + *dir_ +
-                       "/bench/manifest.csv --method " + method +
-                       (method == "rld" ? " --rld_samples 3000" : "") + " --vocabulary 100 --out " + out,
-                   &output);
+    const int code = RunCommand(
+        std::string(MESHSEEK_CLI_PATH) + " eval --progress=false --manifest " + *dir_ +
+            "/bench/manifest.csv --method " + method +
+            (method == "rld" ? " --rld_samples 3000" : "") + " --vocabulary 100 --out " + out,
+        &output);
     ASSERT_EQ(code, 0) << output;
     EXPECT_THAT(output, HasSubstr("RP_excl"));
     EXPECT_TRUE(ReadDistanceMatrix(out + "/distances.bin", 72).ok());

@@ -231,7 +231,8 @@ class ServicesTest : public ::testing::Test {
     delete reference_;
   }
 
-  static absl::Status CreateCollection(v1::Coordinator::Stub* stub, const std::string& name,
+  static absl::Status CreateCollection(v1::Coordinator::Stub* stub,
+                                       const std::string& name,
                                        const v1::PipelineParams& params = TestParams()) {
     grpc::ClientContext context;
     rpc::SetDeadline(&context, absl::Seconds(10));
@@ -309,7 +310,8 @@ class ServicesTest : public ::testing::Test {
   }
 
   // The collection's matrix, reordered to manifest order.
-  static std::vector<float> Evaluate(v1::Coordinator::Stub* stub, const std::string& collection,
+  static std::vector<float> Evaluate(v1::Coordinator::Stub* stub,
+                                     const std::string& collection,
                                      std::size_t models = 0) {
     grpc::ClientContext context;
     rpc::SetDeadline(&context, absl::Minutes(1));

@@ -137,9 +137,8 @@ absl::StatusOr<std::vector<float>> Codebook::Encode(const uint8_t* descriptors,
         "codebook: cannot encode an empty descriptor set (0 descriptors)");
   }
   if (dimension != dim_) {
-    return absl::InvalidArgumentError(absl::StrCat("codebook: descriptors of dimension ", dimension,
-                                                   ", the codebook's words have ",
-                                                   dim_));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "codebook: descriptors of dimension ", dimension, ", the codebook's words have ", dim_));
   }
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<uint32_t> labels,
                             NearestCentroids(descriptors, count));

@@ -65,7 +65,8 @@ TEST(CodebookTest, EncodeIsTheNormalisedHistogramOfNearestWords) {
   const Codebook codebook = RandomCodebook(50, kDim, 3);
   const std::size_t count = 777;
   const std::vector<uint8_t> descriptors = RandomDescriptors(count, kDim, 4);
-  const absl::StatusOr<std::vector<float>> histogram = codebook.Encode(descriptors.data(), count, kDim);
+  const absl::StatusOr<std::vector<float>> histogram =
+      codebook.Encode(descriptors.data(), count, kDim);
   ASSERT_TRUE(histogram.ok()) << histogram.status();
   ASSERT_EQ(histogram->size(), 50u);
   std::vector<double> expected(50, 0.0);

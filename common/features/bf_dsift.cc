@@ -98,7 +98,8 @@ absl::StatusOr<LocalFeatures> ExtractBfDsift(const TriangleMesh& mesh,
   const int n = options.view_size;
   const int image = options.patch_image.image_size;
   const double largest_radius = options.patch_radius * n * (1 << (options.patch_scales - 1));
-  const int levels = 1 + std::max(0, static_cast<int>(std::floor(std::log2(2 * largest_radius / image))));
+  const int levels =
+      1 + std::max(0, static_cast<int>(std::floor(std::log2(2 * largest_radius / image))));
 
   LocalFeatures features;
   DepthSiftDescriber describer(options.descriptor);
@@ -125,7 +126,8 @@ absl::StatusOr<LocalFeatures> ExtractBfDsift(const TriangleMesh& mesh,
           // The pyramid level whose pixels are no larger than the patch's.
           const double pixel = 2 * radius / image;
           const int level =
-              std::clamp(static_cast<int>(std::floor(std::log2(std::max(pixel, 1.0)))), 0,
+              std::clamp(static_cast<int>(std::floor(std::log2(std::max(pixel, 1.0)))),
+                         0,
                          static_cast<int>(pyramid.levels.size()) - 1);
           patch.support_radius = static_cast<float>(radius);
           const double near = centre - radius;
@@ -141,15 +143,16 @@ absl::StatusOr<LocalFeatures> ExtractBfDsift(const TriangleMesh& mesh,
           // The surface point at the patch centre, back in model units.
           const double a = (px + 0.5) / n * 2 - 1, b = 1 - (py + 0.5) / n * 2;
           const double c = 1 - 2 * view.DepthAt(px, py);
-          const Vec3d q = sphere.center + (camera.right * a + camera.up * b + camera.direction * c) *
-                                              sphere.radius;
+          const Vec3d q = sphere.center +
+                          (camera.right * a + camera.up * b + camera.direction * c) * sphere.radius;
           Keypoint k;
-          k.position = Vec3f(static_cast<float>(q.x), static_cast<float>(q.y),
-                             static_cast<float>(q.z));
+          k.position =
+              Vec3f(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
           k.view = Vec3f(static_cast<float>(camera.direction.x),
                          static_cast<float>(camera.direction.y),
                          static_cast<float>(camera.direction.z));
-          k.up = Vec3f(static_cast<float>(camera.up.x), static_cast<float>(camera.up.y),
+          k.up = Vec3f(static_cast<float>(camera.up.x),
+                       static_cast<float>(camera.up.y),
                        static_cast<float>(camera.up.z));
           k.scale = static_cast<float>(radius / n * sphere.diameter());
           k.level = s;

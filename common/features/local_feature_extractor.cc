@@ -54,27 +54,50 @@ float LightFieldDistance(const uint8_t* a, const uint8_t* b, std::size_t) {
 
 const std::vector<FeatureMethodInfo>& FeatureMethods() {
   static const auto* const kMethods = new std::vector<FeatureMethodInfo>{
-      {FeatureMethod::kDldSift, "dld", "DLD-SIFT: dense local depth-image SIFT (the paper's)",
-       DescriptorKind::kBagOfFeatures, 2000,
-       [](const ExtractorOptions& o) { return o.dld.Validate(); }, ExtractDld},
-      {FeatureMethod::kRldSift, "rld", "RLD-SIFT: LD-SIFT on a resampled point graph (the paper's)",
-       DescriptorKind::kBagOfFeatures, 2000,
-       [](const ExtractorOptions& o) { return o.rld.Validate(); }, ExtractRld},
-      {FeatureMethod::kLdSift, "ld", "LD-SIFT (Darom & Keller): salient points on the mesh",
-       DescriptorKind::kBagOfFeatures, 2000,
-       [](const ExtractorOptions& o) { return o.ld.Validate(); }, ExtractLd},
-      {FeatureMethod::kBfDsift, "bfdsift",
+      {FeatureMethod::kDldSift,
+       "dld",
+       "DLD-SIFT: dense local depth-image SIFT (the paper's)",
+       DescriptorKind::kBagOfFeatures,
+       2000,
+       [](const ExtractorOptions& o) { return o.dld.Validate(); },
+       ExtractDld},
+      {FeatureMethod::kRldSift,
+       "rld",
+       "RLD-SIFT: LD-SIFT on a resampled point graph (the paper's)",
+       DescriptorKind::kBagOfFeatures,
+       2000,
+       [](const ExtractorOptions& o) { return o.rld.Validate(); },
+       ExtractRld},
+      {FeatureMethod::kLdSift,
+       "ld",
+       "LD-SIFT (Darom & Keller): salient points on the mesh",
+       DescriptorKind::kBagOfFeatures,
+       2000,
+       [](const ExtractorOptions& o) { return o.ld.Validate(); },
+       ExtractLd},
+      {FeatureMethod::kBfDsift,
+       "bfdsift",
        "BF-DSIFT (Furuya & Ohbuchi): dense SIFT on depth views of the whole model",
-       DescriptorKind::kBagOfFeatures, 8000,
-       [](const ExtractorOptions& o) { return o.bfdsift.Validate(); }, ExtractBf},
-      {FeatureMethod::kLsf, "lsf",
+       DescriptorKind::kBagOfFeatures,
+       8000,
+       [](const ExtractorOptions& o) { return o.bfdsift.Validate(); },
+       ExtractBf},
+      {FeatureMethod::kLsf,
+       "lsf",
        "LSF: joint histograms of distance and normal angles about dense surface samples",
-       DescriptorKind::kBagOfFeatures, 2000,
-       [](const ExtractorOptions& o) { return o.lsf.Validate(); }, ExtractLocalStatistics},
-      {FeatureMethod::kLfd, "lfd",
+       DescriptorKind::kBagOfFeatures,
+       2000,
+       [](const ExtractorOptions& o) { return o.lsf.Validate(); },
+       ExtractLocalStatistics},
+      {FeatureMethod::kLfd,
+       "lfd",
        "LFD (Chen et al.): Zernike and Fourier silhouette descriptors of 10 light fields",
-       DescriptorKind::kGlobal, 0, [](const ExtractorOptions& o) { return o.lfd.Validate(); },
-       ExtractLightField, LightFieldDistance, kLfdDescriptorBytes},
+       DescriptorKind::kGlobal,
+       0,
+       [](const ExtractorOptions& o) { return o.lfd.Validate(); },
+       ExtractLightField,
+       LightFieldDistance,
+       kLfdDescriptorBytes},
   };
   return *kMethods;
 }
@@ -92,8 +115,8 @@ absl::StatusOr<FeatureMethod> ParseFeatureMethod(absl::string_view name) {
     if (name == info.name) return info.method;
     known.push_back(info.name);
   }
-  return absl::InvalidArgumentError(absl::StrCat("unknown feature method '", name,
-                                                 "' (known: ", absl::StrJoin(known, ", "), ")"));
+  return absl::InvalidArgumentError(absl::StrCat(
+      "unknown feature method '", name, "' (known: ", absl::StrJoin(known, ", "), ")"));
 }
 
 const char* FeatureMethodName(FeatureMethod method) { return FeatureMethodInfoOf(method).name; }
@@ -109,14 +132,25 @@ absl::StatusOr<float> GlobalDistance(FeatureMethod method,
   if (a.size() != 1 || b.size() != 1 || a.dimension != info.descriptor_bytes ||
       b.dimension != info.descriptor_bytes || a.descriptors.size() != a.dimension ||
       b.descriptors.size() != b.dimension) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "method ", info.name, ": a global descriptor is one feature of ", info.descriptor_bytes,
-        " bytes, got ", a.size(), " of ", a.dimension, " and ", b.size(), " of ", b.dimension));
+    return absl::InvalidArgumentError(absl::StrCat("method ",
+                                                   info.name,
+                                                   ": a global descriptor is one feature of ",
+                                                   info.descriptor_bytes,
+                                                   " bytes, got ",
+                                                   a.size(),
+                                                   " of ",
+                                                   a.dimension,
+                                                   " and ",
+                                                   b.size(),
+                                                   " of ",
+                                                   b.dimension));
   }
   return info.distance(a.descriptors.data(), b.descriptors.data(), a.dimension);
 }
 
-absl::Status ExtractorOptions::Validate() const { return FeatureMethodInfoOf(method).validate(*this); }
+absl::Status ExtractorOptions::Validate() const {
+  return FeatureMethodInfoOf(method).validate(*this);
+}
 
 absl::StatusOr<LocalFeatures> ExtractLocalFeatures(const TriangleMesh& mesh,
                                                    const ExtractorOptions& options,

@@ -18,8 +18,8 @@
 // q = min(255, floor(s * v)) with s = 256 for Zernike (v in [0, 1]) and
 // s = 512 for Fourier (the original's FD_SCALE of 2). On PSB train no byte
 // saturates; the median byte is 6 (Zernike) and 10 (Fourier), the 99th
-// percentile 139 and 165 (bench/results/lfd.txt). An empty silhouette (a view that sees nothing, e.g. a model
-// thinner than a pixel) gives zeros, never NaN.
+// percentile 139 and 165 (bench/results/lfd.txt). An empty silhouette (a view that sees nothing,
+// e.g. a model thinner than a pixel) gives zeros, never NaN.
 //
 // Descriptor layout (kLfdDescriptorBytes = 4,800 bytes, fixed): light field
 // l in 0..9, view v in 0..9, block (10 l + v) of kLfdViewStride = 48 bytes:

@@ -1,9 +1,9 @@
 #include "common/pipeline/pipeline_params.h"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstdint>
 #include <limits>
 #include <set>
 
@@ -49,15 +49,25 @@ std::string Text(double v) {
 template <typename T>
 ParamType TypeOf();
 template <>
-ParamType TypeOf<int>() { return ParamType::kInt; }
+ParamType TypeOf<int>() {
+  return ParamType::kInt;
+}
 template <>
-ParamType TypeOf<uint64_t>() { return ParamType::kUint64; }
+ParamType TypeOf<uint64_t>() {
+  return ParamType::kUint64;
+}
 template <>
-ParamType TypeOf<double>() { return ParamType::kDouble; }
+ParamType TypeOf<double>() {
+  return ParamType::kDouble;
+}
 template <>
-ParamType TypeOf<bool>() { return ParamType::kBool; }
+ParamType TypeOf<bool>() {
+  return ParamType::kBool;
+}
 template <>
-ParamType TypeOf<std::vector<double>>() { return ParamType::kDoubleList; }
+ParamType TypeOf<std::vector<double>>() {
+  return ParamType::kDoubleList;
+}
 
 void Parse(absl::string_view text, int* v) { (void)absl::SimpleAtoi(text, v); }
 void Parse(absl::string_view text, uint64_t* v) { (void)absl::SimpleAtoi(text, v); }
@@ -75,8 +85,13 @@ void Parse(absl::string_view text, std::vector<double>* v) {
 // A parameter stored in one field of the selected method's options: `field`
 // returns that field (it may look at options.extractor.method).
 template <typename T>
-ParamSpec Field(std::string name, std::string doc, double min, double max, Scope scope,
-                std::vector<FeatureMethod> methods, T& (*field)(Options&)) {
+ParamSpec Field(std::string name,
+                std::string doc,
+                double min,
+                double max,
+                Scope scope,
+                std::vector<FeatureMethod> methods,
+                T& (*field)(Options&)) {
   ParamSpec spec;
   spec.name = std::move(name);
   spec.type = TypeOf<T>();
@@ -92,8 +107,11 @@ ParamSpec Field(std::string name, std::string doc, double min, double max, Scope
 
 // A parameter with named values stored as an enumerator.
 template <typename E>
-ParamSpec Choice(std::string name, std::string doc, Scope scope,
-                 std::vector<FeatureMethod> methods, E& (*field)(Options&),
+ParamSpec Choice(std::string name,
+                 std::string doc,
+                 Scope scope,
+                 std::vector<FeatureMethod> methods,
+                 E& (*field)(Options&),
                  std::vector<std::pair<std::string, E>> values) {
   ParamSpec spec;
   spec.name = std::move(name);
@@ -120,18 +138,26 @@ ParamSpec Choice(std::string name, std::string doc, Scope scope,
 // The sub-options every SIFT method has, of the selected method.
 DepthImageOptions& DepthImage(Options& o) {
   switch (o.extractor.method) {
-    case kLd: return o.extractor.ld.depth_image;
-    case kRld: return o.extractor.rld.depth_image;
-    case kBf: return o.extractor.bfdsift.patch_image;
-    default: return o.extractor.dld.depth_image;
+    case kLd:
+      return o.extractor.ld.depth_image;
+    case kRld:
+      return o.extractor.rld.depth_image;
+    case kBf:
+      return o.extractor.bfdsift.patch_image;
+    default:
+      return o.extractor.dld.depth_image;
   }
 }
 SiftDescriptorOptions& Sift(Options& o) {
   switch (o.extractor.method) {
-    case kLd: return o.extractor.ld.descriptor;
-    case kRld: return o.extractor.rld.descriptor;
-    case kBf: return o.extractor.bfdsift.descriptor;
-    default: return o.extractor.dld.descriptor;
+    case kLd:
+      return o.extractor.ld.descriptor;
+    case kRld:
+      return o.extractor.rld.descriptor;
+    case kBf:
+      return o.extractor.bfdsift.descriptor;
+    default:
+      return o.extractor.dld.descriptor;
   }
 }
 ScaleSpaceOptions& ScaleSpace(Options& o) {
@@ -151,7 +177,9 @@ std::vector<ParamSpec> MakeSpecs() {
       titles.push_back(absl::StrCat(info.name, " (", info.title, ")"));
     }
     method.doc = absl::StrCat("feature method: ", absl::StrJoin(titles, " | "));
-    method.get = [](const Options& o) { return std::string(FeatureMethodName(o.extractor.method)); };
+    method.get = [](const Options& o) {
+      return std::string(FeatureMethodName(o.extractor.method));
+    };
     method.set = [](absl::string_view text, Options* o) {
       *o = Options::ForMethod(*ParseFeatureMethod(text));
     };
@@ -159,128 +187,268 @@ std::vector<ParamSpec> MakeSpecs() {
   }
   const Scope listed = Scope::kListed;
   specs.push_back(Field<double>(
-      "scale", "support radius E relative to the minimum enclosing sphere (s = E * D / 2)", 1e-6, 2,
-      listed, {kDld, kLsf}, +[](Options& o) -> double& {
+      "scale",
+      "support radius E relative to the minimum enclosing sphere (s = E * D / 2)",
+      1e-6,
+      2,
+      listed,
+      {kDld, kLsf},
+      +[](Options& o) -> double& {
         return o.extractor.method == kLsf ? o.extractor.lsf.scale : o.extractor.dld.scale;
       }));
-  specs.push_back(Field<int>("points", "feature points per model (N_DLD, LSF's centres)", 1,
-                             1000000, listed, {kDld, kLsf}, +[](Options& o) -> int& {
-                               return o.extractor.method == kLsf ? o.extractor.lsf.num_points
-                                                                 : o.extractor.dld.num_points;
-                             }));
+  specs.push_back(Field<int>(
+      "points",
+      "feature points per model (N_DLD, LSF's centres)",
+      1,
+      1000000,
+      listed,
+      {kDld, kLsf},
+      +[](Options& o) -> int& {
+        return o.extractor.method == kLsf ? o.extractor.lsf.num_points : o.extractor.dld.num_points;
+      }));
   specs.push_back(Field<std::vector<double>>(
-      "extra_scales", "further support radii (as scale), every centre described at each", 1e-6, 2,
-      listed, {kLsf},
+      "extra_scales",
+      "further support radii (as scale), every centre described at each",
+      1e-6,
+      2,
+      listed,
+      {kLsf},
       +[](Options& o) -> std::vector<double>& { return o.extractor.lsf.extra_scales; }));
   specs.push_back(Field<int>(
-      "samples_per_support", "oriented surface samples in a flat disc of the support radius", 8,
-      100000, listed, {kLsf},
+      "samples_per_support",
+      "oriented surface samples in a flat disc of the support radius",
+      8,
+      100000,
+      listed,
+      {kLsf},
       +[](Options& o) -> int& { return o.extractor.lsf.samples_per_support; }));
-  specs.push_back(Field<int>("distance_bins", "histogram bins over the distance to the centre", 1,
-                             64, listed, {kLsf},
-                             +[](Options& o) -> int& { return o.extractor.lsf.distance_bins; }));
-  specs.push_back(Field<int>("angle_bins", "histogram bins over each normal angle", 1, 64, listed,
-                             {kLsf},
-                             +[](Options& o) -> int& { return o.extractor.lsf.angle_bins; }));
   specs.push_back(Field<int>(
-      "frame_samples", "dense surface samples per support disc for the local PCA frame", 8, 1000000,
-      listed, {kDld},
+      "distance_bins",
+      "histogram bins over the distance to the centre",
+      1,
+      64,
+      listed,
+      {kLsf},
+      +[](Options& o) -> int& { return o.extractor.lsf.distance_bins; }));
+  specs.push_back(Field<int>(
+      "angle_bins",
+      "histogram bins over each normal angle",
+      1,
+      64,
+      listed,
+      {kLsf},
+      +[](Options& o) -> int& { return o.extractor.lsf.angle_bins; }));
+  specs.push_back(Field<int>(
+      "frame_samples",
+      "dense surface samples per support disc for the local PCA frame",
+      8,
+      1000000,
+      listed,
+      {kDld},
       +[](Options& o) -> int& { return o.extractor.dld.frame_samples_per_support; }));
   specs.push_back(Field<double>(
-      "frame_radius", "the local frame uses the samples within this many support radii", 0.25, 4,
-      listed, {kDld}, +[](Options& o) -> double& { return o.extractor.dld.frame_radius_factor; }));
+      "frame_radius",
+      "the local frame uses the samples within this many support radii",
+      0.25,
+      4,
+      listed,
+      {kDld},
+      +[](Options& o) -> double& { return o.extractor.dld.frame_radius_factor; }));
   specs.push_back(Field<bool>(
-      "weighted_frame", "distance-weighted (SHOT-style) PCA frame instead of plain PCA", 0, 1,
-      listed, {kDld, kRld}, +[](Options& o) -> bool& {
+      "weighted_frame",
+      "distance-weighted (SHOT-style) PCA frame instead of plain PCA",
+      0,
+      1,
+      listed,
+      {kDld, kRld},
+      +[](Options& o) -> bool& {
         return o.extractor.method == kRld ? o.extractor.rld.weighted_frame
                                           : o.extractor.dld.weighted_frame;
       }));
-  specs.push_back(Field<int>("rld_samples", "resample points (N_RLD)", 100, 10000000, listed,
-                             {kRld},
-                             +[](Options& o) -> int& { return o.extractor.rld.num_samples; }));
-  specs.push_back(Field<int>("rld_neighbors", "k of the k-nearest-neighbour graph", 1, 100, listed,
-                             {kRld}, +[](Options& o) -> int& { return o.extractor.rld.neighbors; }));
-  specs.push_back(Field<int>("levels", "scale-space levels L", 2, 200, listed, {kLd, kRld},
-                             +[](Options& o) -> int& { return ScaleSpace(o).levels; }));
+  specs.push_back(Field<int>(
+      "rld_samples",
+      "resample points (N_RLD)",
+      100,
+      10000000,
+      listed,
+      {kRld},
+      +[](Options& o) -> int& { return o.extractor.rld.num_samples; }));
+  specs.push_back(Field<int>(
+      "rld_neighbors",
+      "k of the k-nearest-neighbour graph",
+      1,
+      100,
+      listed,
+      {kRld},
+      +[](Options& o) -> int& { return o.extractor.rld.neighbors; }));
+  specs.push_back(Field<int>(
+      "levels", "scale-space levels L", 2, 200, listed, {kLd, kRld}, +[](Options& o) -> int& {
+        return ScaleSpace(o).levels;
+      }));
   specs.push_back(Field<double>(
-      "scale_factor", "C in the feature scale s = C * d * sqrt(level)", 1e-6, 1e6, listed,
-      {kLd, kRld}, +[](Options& o) -> double& { return ScaleSpace(o).scale_factor; }));
+      "scale_factor",
+      "C in the feature scale s = C * d * sqrt(level)",
+      1e-6,
+      1e6,
+      listed,
+      {kLd, kRld},
+      +[](Options& o) -> double& { return ScaleSpace(o).scale_factor; }));
   specs.push_back(Field<int>(
-      "view_level", "view directions: vertices of the icosahedron subdivided this often (1: 42)",
-      0, 3, listed, {kBf}, +[](Options& o) -> int& { return o.extractor.bfdsift.view_level; }));
-  specs.push_back(Field<int>("view_size", "side of each whole-model view in pixels", 32, 1024,
-                             listed, {kBf, kLfd}, +[](Options& o) -> int& {
-                               return o.extractor.method == kLfd ? o.extractor.lfd.image_size
-                                                                 : o.extractor.bfdsift.view_size;
-                             }));
+      "view_level",
+      "view directions: vertices of the icosahedron subdivided this often (1: 42)",
+      0,
+      3,
+      listed,
+      {kBf},
+      +[](Options& o) -> int& { return o.extractor.bfdsift.view_level; }));
   specs.push_back(Field<int>(
-      "contour_samples", "points the silhouette's outer contour is resampled to (Fourier)", 21,
-      65536, listed, {kLfd}, +[](Options& o) -> int& { return o.extractor.lfd.contour_samples; }));
+      "view_size",
+      "side of each whole-model view in pixels",
+      32,
+      1024,
+      listed,
+      {kBf, kLfd},
+      +[](Options& o) -> int& {
+        return o.extractor.method == kLfd ? o.extractor.lfd.image_size
+                                          : o.extractor.bfdsift.view_size;
+      }));
+  specs.push_back(Field<int>(
+      "contour_samples",
+      "points the silhouette's outer contour is resampled to (Fourier)",
+      21,
+      65536,
+      listed,
+      {kLfd},
+      +[](Options& o) -> int& { return o.extractor.lfd.contour_samples; }));
   specs.push_back(Choice<LfdZernikeRadius>(
-      "zernike_radius", "Zernike disc radius: per view | per light field (the original's)", listed,
-      {kLfd}, +[](Options& o) -> LfdZernikeRadius& { return o.extractor.lfd.zernike_radius; },
+      "zernike_radius",
+      "Zernike disc radius: per view | per light field (the original's)",
+      listed,
+      {kLfd},
+      +[](Options& o) -> LfdZernikeRadius& { return o.extractor.lfd.zernike_radius; },
       {{"view", LfdZernikeRadius::kPerView}, {"lightfield", LfdZernikeRadius::kPerLightField}}));
   specs.push_back(Field<int>(
-      "points_per_view", "dense grid points per view inside the silhouette", 1, 100000, listed,
-      {kBf}, +[](Options& o) -> int& { return o.extractor.bfdsift.points_per_view; }));
+      "points_per_view",
+      "dense grid points per view inside the silhouette",
+      1,
+      100000,
+      listed,
+      {kBf},
+      +[](Options& o) -> int& { return o.extractor.bfdsift.points_per_view; }));
   specs.push_back(Field<double>(
-      "patch_radius", "smallest SIFT patch radius relative to the view's side", 1e-3, 0.5, listed,
-      {kBf}, +[](Options& o) -> double& { return o.extractor.bfdsift.patch_radius; }));
+      "patch_radius",
+      "smallest SIFT patch radius relative to the view's side",
+      1e-3,
+      0.5,
+      listed,
+      {kBf},
+      +[](Options& o) -> double& { return o.extractor.bfdsift.patch_radius; }));
   specs.push_back(Field<int>(
-      "patch_scales", "patch radii per point: patch_radius, twice it, ...", 1, 4, listed, {kBf},
+      "patch_scales",
+      "patch radii per point: patch_radius, twice it, ...",
+      1,
+      4,
+      listed,
+      {kBf},
       +[](Options& o) -> int& { return o.extractor.bfdsift.patch_scales; }));
-  specs.push_back(Field<int>("image_size", "local depth image side I in pixels (odd)", 3, 255,
-                             listed, {kDld, kLd, kRld, kBf},
-                             +[](Options& o) -> int& { return DepthImage(o).image_size; }));
+  specs.push_back(Field<int>(
+      "image_size",
+      "local depth image side I in pixels (odd)",
+      3,
+      255,
+      listed,
+      {kDld, kLd, kRld, kBf},
+      +[](Options& o) -> int& { return DepthImage(o).image_size; }));
   specs.push_back(Choice<ImageOrientation>(
-      "orientation", "descriptor rotation: Lowe's gradient peaks | PCA up axis + 180-degree sum",
-      listed, {kDld, kLd, kRld, kBf},
+      "orientation",
+      "descriptor rotation: Lowe's gradient peaks | PCA up axis + 180-degree sum",
+      listed,
+      {kDld, kLd, kRld, kBf},
       +[](Options& o) -> ImageOrientation& { return Sift(o).orientation; },
       {{"dominant", ImageOrientation::kDominant}, {"up", ImageOrientation::kUpAxis}}));
   specs.push_back(Choice<DepthToGray>(
-      "depth_to_gray", "depth to grey: fixed (2s range) | stretch (image range)", listed,
-      {kDld, kLd, kRld, kBf}, +[](Options& o) -> DepthToGray& { return Sift(o).depth_to_gray; },
+      "depth_to_gray",
+      "depth to grey: fixed (2s range) | stretch (image range)",
+      listed,
+      {kDld, kLd, kRld, kBf},
+      +[](Options& o) -> DepthToGray& { return Sift(o).depth_to_gray; },
       {{"fixed", DepthToGray::kFixedRange}, {"stretch", DepthToGray::kStretch}}));
   specs.push_back(Field<int>(
       "max_orientations",
       "with dominant orientation: at most this many descriptors per image (0: every peak within "
       "80 % of the highest)",
-      0, 36, listed, {kDld, kLd, kRld, kBf},
+      0,
+      36,
+      listed,
+      {kDld, kLd, kRld, kBf},
       +[](Options& o) -> int& { return Sift(o).max_orientations; }));
-  specs.push_back(Field<double>("blur_sigma", "SIFT blur sigma in pixels", 0.5, 5, listed,
-                                {kDld, kLd, kRld, kBf},
-                                +[](Options& o) -> double& { return Sift(o).blur_sigma; }));
+  specs.push_back(Field<double>(
+      "blur_sigma",
+      "SIFT blur sigma in pixels",
+      0.5,
+      5,
+      listed,
+      {kDld, kLd, kRld, kBf},
+      +[](Options& o) -> double& { return Sift(o).blur_sigma; }));
   const Scope bag = Scope::kBagOfFeatures;
-  specs.push_back(Field<int>("vocabulary", "codebook size V (k-means centroids)", 1,
-                             static_cast<double>(kMaxVocabulary), bag, {},
-                             +[](Options& o) -> int& { return o.kmeans.num_centroids; }));
   specs.push_back(Field<int>(
-      "kmeans_points_per_centroid", "k-means trains on at most this many features per centroid", 1,
-      1000000, bag, {}, +[](Options& o) -> int& { return o.kmeans.max_points_per_centroid; }));
-  specs.push_back(Field<int>("kmeans_iterations", "maximum k-means iterations", 1, 10000, bag, {},
-                             +[](Options& o) -> int& { return o.kmeans.max_iterations; }));
+      "vocabulary",
+      "codebook size V (k-means centroids)",
+      1,
+      static_cast<double>(kMaxVocabulary),
+      bag,
+      {},
+      +[](Options& o) -> int& { return o.kmeans.num_centroids; }));
+  specs.push_back(Field<int>(
+      "kmeans_points_per_centroid",
+      "k-means trains on at most this many features per centroid",
+      1,
+      1000000,
+      bag,
+      {},
+      +[](Options& o) -> int& { return o.kmeans.max_points_per_centroid; }));
+  specs.push_back(Field<int>(
+      "kmeans_iterations",
+      "maximum k-means iterations",
+      1,
+      10000,
+      bag,
+      {},
+      +[](Options& o) -> int& { return o.kmeans.max_iterations; }));
   specs.push_back(Choice<KMeansOptions::Assignment>(
       "kmeans_assignment",
       "nearest-word search of k-means and encoding: auto (exact below V = 1,000, approximate "
       "from there) | exact | approximate",
-      bag, {}, +[](Options& o) -> KMeansOptions::Assignment& { return o.kmeans.assignment; },
+      bag,
+      {},
+      +[](Options& o) -> KMeansOptions::Assignment& { return o.kmeans.assignment; },
       {{"auto", KMeansOptions::Assignment::kAuto},
        {"exact", KMeansOptions::Assignment::kExact},
        {"approximate", KMeansOptions::Assignment::kApproximate}}));
-  specs.push_back(Field<uint64_t>("seed", "seed of k-means sampling and seeding", 0,
-                                  static_cast<double>(std::numeric_limits<uint64_t>::max()), bag,
-                                  {}, +[](Options& o) -> uint64_t& { return o.kmeans.seed; }));
+  specs.push_back(Field<uint64_t>(
+      "seed",
+      "seed of k-means sampling and seeding",
+      0,
+      static_cast<double>(std::numeric_limits<uint64_t>::max()),
+      bag,
+      {},
+      +[](Options& o) -> uint64_t& { return o.kmeans.seed; }));
   specs.push_back(Field<double>(
-      "kl_epsilon", "mass added to every histogram bin before KL divergence (zero-bin rule)",
-      1e-30, 0.5, bag, {}, +[](Options& o) -> double& { return o.kl.epsilon; }));
+      "kl_epsilon",
+      "mass added to every histogram bin before KL divergence (zero-bin rule)",
+      1e-30,
+      0.5,
+      bag,
+      {},
+      +[](Options& o) -> double& { return o.kl.epsilon; }));
   return specs;
 }
 
 // Parses and range-checks `text` as the spec's type.
 absl::Status CheckValue(const ParamSpec& spec, absl::string_view text) {
   auto bad = [&]() {
-    return absl::InvalidArgumentError(absl::StrCat("parameter ", spec.name, ": '", text,
-                                                   "' is not ", spec.TypeDescription()));
+    return absl::InvalidArgumentError(
+        absl::StrCat("parameter ", spec.name, ": '", text, "' is not ", spec.TypeDescription()));
   };
   switch (spec.type) {
     case ParamType::kInt: {
@@ -325,9 +493,12 @@ absl::Status CheckValue(const ParamSpec& spec, absl::string_view text) {
 
 std::string MethodNames(const ParamSpec& spec) {
   switch (spec.scope) {
-    case Scope::kAll: return "every method";
-    case Scope::kBagOfFeatures: return "bag-of-features methods";
-    case Scope::kListed: break;
+    case Scope::kAll:
+      return "every method";
+    case Scope::kBagOfFeatures:
+      return "bag-of-features methods";
+    case Scope::kListed:
+      break;
   }
   std::vector<std::string> names;
   for (FeatureMethod m : spec.methods) names.push_back(FeatureMethodName(m));
@@ -338,7 +509,8 @@ std::string MethodNames(const ParamSpec& spec) {
 
 bool ParamSpec::AppliesTo(FeatureMethod method) const {
   switch (scope) {
-    case Scope::kAll: return true;
+    case Scope::kAll:
+      return true;
     case Scope::kBagOfFeatures:
       return FeatureMethodInfoOf(method).kind == DescriptorKind::kBagOfFeatures;
     case Scope::kListed:
@@ -353,12 +525,16 @@ bool ParamSpec::AppliesTo(FeatureMethod method) const {
 std::string ParamSpec::TypeDescription() const {
   switch (type) {
     case ParamType::kInt:
-      return absl::StrCat("an integer in [", static_cast<int64_t>(min), ", ",
-                          static_cast<int64_t>(max), "]");
-    case ParamType::kUint64: return "an unsigned 64-bit integer";
-    case ParamType::kDouble: return absl::StrCat("a number in [", Text(min), ", ", Text(max), "]");
-    case ParamType::kBool: return "true or false";
-    case ParamType::kChoice: return absl::StrCat("one of ", absl::StrJoin(choices, ", "));
+      return absl::StrCat(
+          "an integer in [", static_cast<int64_t>(min), ", ", static_cast<int64_t>(max), "]");
+    case ParamType::kUint64:
+      return "an unsigned 64-bit integer";
+    case ParamType::kDouble:
+      return absl::StrCat("a number in [", Text(min), ", ", Text(max), "]");
+    case ParamType::kBool:
+      return "true or false";
+    case ParamType::kChoice:
+      return absl::StrCat("one of ", absl::StrJoin(choices, ", "));
     case ParamType::kDoubleList:
       return absl::StrCat("up to 8 comma-separated numbers in [", Text(min), ", ", Text(max), "]");
   }
@@ -393,13 +569,17 @@ absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromValues(const ParamVa
     if (spec == nullptr) {
       std::vector<std::string> known;
       for (const ParamSpec& s : PipelineParamSpecs()) known.push_back(s.name);
-      return absl::InvalidArgumentError(absl::StrCat("unknown parameter '", name,
-                                                     "' (known: ", absl::StrJoin(known, ", "), ")"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("unknown parameter '", name, "' (known: ", absl::StrJoin(known, ", "), ")"));
     }
     if (!spec->AppliesTo(options.extractor.method)) {
-      return absl::InvalidArgumentError(absl::StrCat("parameter ", name, " does not apply to method ",
-                                                     method, " (it applies to ",
-                                                     MethodNames(*spec), ")"));
+      return absl::InvalidArgumentError(absl::StrCat("parameter ",
+                                                     name,
+                                                     " does not apply to method ",
+                                                     method,
+                                                     " (it applies to ",
+                                                     MethodNames(*spec),
+                                                     ")"));
     }
     MESHSEEK_RETURN_IF_ERROR(CheckValue(*spec, value));
     spec->set(value, &options);
@@ -438,8 +618,12 @@ Json PipelineParamsToJson(const RetrievalPipelineOptions& options) {
         json.Set(spec.name, v);
         break;
       }
-      case ParamType::kBool: json.Set(spec.name, text == "true"); break;
-      case ParamType::kChoice: json.Set(spec.name, text); break;
+      case ParamType::kBool:
+        json.Set(spec.name, text == "true");
+        break;
+      case ParamType::kChoice:
+        json.Set(spec.name, text);
+        break;
       case ParamType::kDoubleList: {
         Json& list = json.Set(spec.name, Json::MakeArray());
         std::vector<double> values;
@@ -469,8 +653,8 @@ std::string PipelineParamsUsage() {
     if (spec.name == "method") {
       absl::StrAppend(&usage, "      default: ", FeatureMethodName(FeatureMethod::kDldSift), "\n");
     } else {
-      absl::StrAppend(&usage, "      ", MethodNames(spec), "; default: ",
-                      absl::StrJoin(defaults, ", "), "\n");
+      absl::StrAppend(
+          &usage, "      ", MethodNames(spec), "; default: ", absl::StrJoin(defaults, ", "), "\n");
     }
   }
   return usage;

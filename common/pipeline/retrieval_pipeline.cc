@@ -141,8 +141,8 @@ absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
   std::vector<absl::Status> errors(features.size());
   ParallelFor(features.size(), options.num_threads, [&](std::size_t i) {
     if (features[i].size() == 0) return;  // no histogram: see RankCollection
-    auto histogram = codebook.Encode(features[i].descriptors.data(), features[i].size(),
-                                     features[i].dimension);
+    auto histogram =
+        codebook.Encode(features[i].descriptors.data(), features[i].size(), features[i].dimension);
     if (histogram.ok()) {
       histograms[i] = *std::move(histogram);
     } else {
@@ -254,8 +254,7 @@ absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<Manife
     result.timings.codebook_seconds = SecondsSince(stage);
 
     stage = std::chrono::steady_clock::now();
-    MESHSEEK_ASSIGN_OR_RETURN(const auto histograms,
-                              EncodeCollection(codebook, features, options));
+    MESHSEEK_ASSIGN_OR_RETURN(const auto histograms, EncodeCollection(codebook, features, options));
     result.timings.encode_seconds = SecondsSince(stage);
 
     stage = std::chrono::steady_clock::now();

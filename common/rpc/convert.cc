@@ -102,13 +102,19 @@ absl::StatusOr<LocalFeatures> FeaturesFromProto(const v1::LocalFeatures& f) {
   // An empty set may leave the dimension unset.
   const std::size_t dim = n == 0 && f.dimension() == 0 ? kSiftDimension : f.dimension();
   if (dim == 0 || dim > kMaxDescriptorDimension) {
-    return absl::InvalidArgumentError(absl::StrCat("local features: descriptor dimension ", dim,
-                                                   ", expected 1 to ", kMaxDescriptorDimension));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "local features: descriptor dimension ", dim, ", expected 1 to ", kMaxDescriptorDimension));
   }
   if (f.descriptors().size() != n * dim) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("local features: ", f.descriptors().size(), " descriptor bytes for ", n,
-                     " features of ", dim, " (need ", n * dim, ")"));
+    return absl::InvalidArgumentError(absl::StrCat("local features: ",
+                                                   f.descriptors().size(),
+                                                   " descriptor bytes for ",
+                                                   n,
+                                                   " features of ",
+                                                   dim,
+                                                   " (need ",
+                                                   n * dim,
+                                                   ")"));
   }
   const bool has_keypoints = f.positions_size() > 0;
   if (has_keypoints &&
@@ -236,9 +242,15 @@ absl::StatusOr<ParamValues> LegacyValues(const v1::PipelineParams& p) {
   FeatureMethod method = FeatureMethod::kDldSift;
   switch (p.method()) {
     case v1::FEATURE_METHOD_UNSPECIFIED:
-    case v1::FEATURE_METHOD_DLD: method = FeatureMethod::kDldSift; break;
-    case v1::FEATURE_METHOD_LD: method = FeatureMethod::kLdSift; break;
-    case v1::FEATURE_METHOD_RLD: method = FeatureMethod::kRldSift; break;
+    case v1::FEATURE_METHOD_DLD:
+      method = FeatureMethod::kDldSift;
+      break;
+    case v1::FEATURE_METHOD_LD:
+      method = FeatureMethod::kLdSift;
+      break;
+    case v1::FEATURE_METHOD_RLD:
+      method = FeatureMethod::kRldSift;
+      break;
     default:
       return absl::InvalidArgumentError(absl::StrCat("params: unknown method ", p.method()));
   }
@@ -257,7 +269,8 @@ absl::StatusOr<ParamValues> LegacyValues(const v1::PipelineParams& p) {
   add("rld_samples", p.rld_samples());
   add("rld_neighbors", p.rld_neighbors());
   add("levels", p.levels());
-  add("scale_factor", method == FeatureMethod::kLdSift ? p.ld_scale_factor() : p.rld_scale_factor());
+  add("scale_factor",
+      method == FeatureMethod::kLdSift ? p.ld_scale_factor() : p.rld_scale_factor());
   add("image_size", p.image_size());
   add("orientation", p.orientation());
   add("depth_to_gray", p.depth_to_gray());
@@ -279,7 +292,8 @@ absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromParams(const v1::Pip
   for (const v1::ParamValue& value : p.values()) values.emplace_back(value.name(), value.value());
   absl::StatusOr<RetrievalPipelineOptions> options = PipelineOptionsFromValues(values);
   if (!options.ok()) {
-    return absl::Status(options.status().code(), absl::StrCat("params: ", options.status().message()));
+    return absl::Status(options.status().code(),
+                        absl::StrCat("params: ", options.status().message()));
   }
   return options;
 }

@@ -17,9 +17,12 @@ absl::StatusOr<GlobalDescriptorIndex> GlobalDescriptorIndex::Create(FeatureMetho
         absl::StrCat("global index: method ", info.name, " has no global descriptor"));
   }
   if (dimension != info.descriptor_bytes) {
-    return absl::InvalidArgumentError(absl::StrCat("global index: ", info.name,
-                                                   " descriptor of ", dimension,
-                                                   " bytes, expected ", info.descriptor_bytes));
+    return absl::InvalidArgumentError(absl::StrCat("global index: ",
+                                                   info.name,
+                                                   " descriptor of ",
+                                                   dimension,
+                                                   " bytes, expected ",
+                                                   info.descriptor_bytes));
   }
   GlobalDescriptorIndex index(method, dimension);
   index.distance_ = info.distance;
@@ -28,8 +31,11 @@ absl::StatusOr<GlobalDescriptorIndex> GlobalDescriptorIndex::Create(FeatureMetho
 
 absl::Status GlobalDescriptorIndex::CheckSize(std::size_t bytes) const {
   if (bytes == dimension_) return absl::OkStatus();
-  return absl::InvalidArgumentError(absl::StrCat("descriptor of ", bytes, " bytes but the ",
-                                                 FeatureMethodName(method_), " collection holds ",
+  return absl::InvalidArgumentError(absl::StrCat("descriptor of ",
+                                                 bytes,
+                                                 " bytes but the ",
+                                                 FeatureMethodName(method_),
+                                                 " collection holds ",
                                                  dimension_));
 }
 

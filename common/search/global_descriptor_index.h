@@ -57,9 +57,9 @@ class GlobalDescriptorIndex {
   FeatureMethod method_;
   std::size_t dimension_;
   float (*distance_)(const uint8_t*, const uint8_t*, std::size_t) = nullptr;
-  std::vector<uint32_t> docs_;                   // slot -> doc
+  std::vector<uint32_t> docs_;                       // slot -> doc
   absl::flat_hash_map<uint32_t, std::size_t> slot_;  // doc -> slot
-  std::vector<uint8_t> data_;                    // slot-major descriptors
+  std::vector<uint8_t> data_;                        // slot-major descriptors
 };
 
 }  // namespace meshseek

@@ -73,8 +73,12 @@ grpc::Status CodebookService::Train(grpc::ServerContext*,
   const std::size_t dim = first.dimension();
   if (dim == 0 || dim > kMaxDescriptorDimension) {
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                        absl::StrCat("train ", id, ": descriptor dimension ", dim,
-                                     ", expected 1 to ", kMaxDescriptorDimension));
+                        absl::StrCat("train ",
+                                     id,
+                                     ": descriptor dimension ",
+                                     dim,
+                                     ", expected 1 to ",
+                                     kMaxDescriptorDimension));
   }
   std::string descriptors = first.descriptors();
   v1::TrainCodebookRequest chunk;
@@ -134,9 +138,8 @@ grpc::Status CodebookService::Encode(grpc::ServerContext*,
   if (!features.ok()) return rpc::ToGrpcStatus(features.status());
   std::vector<float> histogram;  // empty: a model without features
   if (features->size() > 0) {
-    absl::StatusOr<std::vector<float>> encoded =
-        entry->codebook->Encode(features->descriptors.data(), features->size(),
-                                features->dimension);
+    absl::StatusOr<std::vector<float>> encoded = entry->codebook->Encode(
+        features->descriptors.data(), features->size(), features->dimension);
     if (!encoded.ok()) return rpc::ToGrpcStatus(encoded.status());
     histogram = *std::move(encoded);
   }

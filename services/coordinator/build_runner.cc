@@ -116,7 +116,9 @@ absl::Status BuildRunner::Train(const std::string& codebook_id,
         for (const v1::LocalFeatures& f : features) {
           if (f.count() > 0 && f.dimension() != chunk.dimension()) {
             return absl::DataLossError(absl::StrCat("stored features of dimensions ",
-                                                    chunk.dimension(), " and ", f.dimension(),
+                                                    chunk.dimension(),
+                                                    " and ",
+                                                    f.dimension(),
                                                     " in one collection"));
           }
           chunk.mutable_descriptors()->append(f.descriptors());

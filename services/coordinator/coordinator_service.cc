@@ -89,7 +89,8 @@ grpc::Status CoordinatorService::CreateCollection(grpc::ServerContext*,
   if (absl::Status name = CheckName("collection name", request->name(), 128, true); !name.ok()) {
     return rpc::ToGrpcStatus(name);
   }
-  absl::StatusOr<RetrievalPipelineOptions> valid = rpc::PipelineOptionsFromParams(request->params());
+  absl::StatusOr<RetrievalPipelineOptions> valid =
+      rpc::PipelineOptionsFromParams(request->params());
   if (!valid.ok()) {
     return rpc::ToGrpcStatus(Prefixed(valid.status(), absl::StrCat("collection '", request->name(), "': ")));
   }
@@ -100,13 +101,14 @@ grpc::Status CoordinatorService::CreateCollection(grpc::ServerContext*,
   rpc::PipelineParamsToProto(*valid, &canonical);
   if (absl::StatusOr<StoredCollection> existing = store_->GetCollection(request->name());
       existing.ok()) {
-    absl::StatusOr<RetrievalPipelineOptions> stored = rpc::PipelineOptionsFromParams(existing->params);
+    absl::StatusOr<RetrievalPipelineOptions> stored =
+        rpc::PipelineOptionsFromParams(existing->params);
     v1::PipelineParams stored_canonical;
     if (stored.ok()) rpc::PipelineParamsToProto(*stored, &stored_canonical);
-    if (!stored.ok() ||
-        stored_canonical.SerializeAsString() != canonical.SerializeAsString()) {
-      return grpc::Status(grpc::StatusCode::ALREADY_EXISTS,
-                          absl::StrCat("collection '", request->name(), "' exists with other parameters"));
+    if (!stored.ok() || stored_canonical.SerializeAsString() != canonical.SerializeAsString()) {
+      return grpc::Status(
+          grpc::StatusCode::ALREADY_EXISTS,
+          absl::StrCat("collection '", request->name(), "' exists with other parameters"));
     }
   } else if (absl::Status s = store_->CreateCollection(request->name(), canonical); !s.ok()) {
     return rpc::ToGrpcStatus(s);
@@ -269,8 +271,7 @@ grpc::Status CoordinatorService::Query(grpc::ServerContext*,
   rpc::MeshToProto(*mesh, &arrays);
   absl::StatusOr<v1::LocalFeatures> features = workers_.Extract(arrays, *info, "query");
   if (!features.ok()) return rpc::ToGrpcStatus(features.status());
-  absl::StatusOr<IndexSignature> signature =
-      workers_.Encode(*info, info->codebook_id, *features);
+  absl::StatusOr<IndexSignature> signature = workers_.Encode(*info, info->codebook_id, *features);
   if (!signature.ok()) return rpc::ToGrpcStatus(signature.status());
   v1::SearchRequest search;
   search.set_collection(request->collection());

@@ -173,11 +173,11 @@ void Dispatcher::Process(const ModelKey& key) {
   }
   if (info->codebook_id.empty()) return;
   // A built collection: index the new model with the current codebook.
-  absl::StatusOr<IndexSignature> signature =
-      workers_->Encode(*info, info->codebook_id, *features);
-  absl::Status added = signature.ok() ? workers_->AddToIndex(key.collection, key.model_id,
-                                                             model.ordinal, model.label, *signature)
-                                      : signature.status();
+  absl::StatusOr<IndexSignature> signature = workers_->Encode(*info, info->codebook_id, *features);
+  absl::Status added =
+      signature.ok() ? workers_->AddToIndex(
+                           key.collection, key.model_id, model.ordinal, model.label, *signature)
+                     : signature.status();
   if (added.ok()) added = store_->MarkIndexed(key, info->codebook_id);
   if (!added.ok()) {
     MESHSEEK_LOG(WARNING) << "coordinator: model " << key.model_id

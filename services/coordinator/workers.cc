@@ -63,9 +63,13 @@ absl::StatusOr<IndexSignature> Workers::Encode(const CollectionInfo& collection,
   const FeatureMethod method = collection.options.extractor.method;
   if (FeatureMethodInfoOf(method).kind == DescriptorKind::kGlobal) {
     if (features.count() != 1 || features.descriptors().size() != features.dimension()) {
-      return absl::DataLossError(absl::StrCat("features of ", features.count(), " descriptors of ",
-                                              features.dimension(), " bytes, not one global ",
-                                              FeatureMethodName(method), " descriptor"));
+      return absl::DataLossError(absl::StrCat("features of ",
+                                              features.count(),
+                                              " descriptors of ",
+                                              features.dimension(),
+                                              " bytes, not one global ",
+                                              FeatureMethodName(method),
+                                              " descriptor"));
     }
     signature.descriptor.emplace();
     signature.descriptor->set_method(FeatureMethodName(method));

@@ -75,13 +75,17 @@ absl::Status IndexService::Load() {
     absl::StatusOr<Signature> signature =
         histogram.ParseFromString(select.ColumnBlob(4)) &&
                 descriptor.ParseFromString(descriptor_bytes)
-            ? ParseSignature(histogram, descriptor_bytes.empty() ? nullptr : &descriptor,
+            ? ParseSignature(histogram,
+                             descriptor_bytes.empty() ? nullptr : &descriptor,
                              absl::StrCat("model '", model_id, "'"))
             : absl::InvalidArgumentError("does not parse");
     absl::Status placed = signature.status();
     if (placed.ok()) {
-      placed = Place(&collections_[select.ColumnText(0)], model_id,
-                     static_cast<uint64_t>(select.ColumnInt(2)), select.ColumnText(3), *signature);
+      placed = Place(&collections_[select.ColumnText(0)],
+                     model_id,
+                     static_cast<uint64_t>(select.ColumnInt(2)),
+                     select.ColumnText(3),
+                     *signature);
     }
     if (!placed.ok()) {
       return absl::DataLossError(absl::StrCat("index: stored histogram of model '", model_id,
@@ -110,8 +114,10 @@ absl::StatusOr<IndexService::Signature> IndexService::ParseSignature(
         what, ": descriptor of '", descriptor->method(), "', which is not a global method"));
   }
   if (descriptor->data().empty() || descriptor->data().size() > kMaxDescriptorDimension) {
-    return absl::InvalidArgumentError(absl::StrCat(what, ": descriptor of ",
-                                                   descriptor->data().size(), " bytes, expected 1 to ",
+    return absl::InvalidArgumentError(absl::StrCat(what,
+                                                   ": descriptor of ",
+                                                   descriptor->data().size(),
+                                                   " bytes, expected 1 to ",
                                                    kMaxDescriptorDimension));
   }
   signature.descriptor = *descriptor;
@@ -132,10 +138,14 @@ absl::Status IndexService::CheckFits(const Collection& collection,
     const std::string& method = signature.descriptor->method();
     if (method != FeatureMethodName(collection.global->method()) ||
         signature.descriptor->data().size() != collection.global->dimension()) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "a ", method, " descriptor of ", signature.descriptor->data().size(),
-          " bytes, but the collection holds ", FeatureMethodName(collection.global->method()),
-          " descriptors of ", collection.global->dimension()));
+      return absl::InvalidArgumentError(absl::StrCat("a ",
+                                                     method,
+                                                     " descriptor of ",
+                                                     signature.descriptor->data().size(),
+                                                     " bytes, but the collection holds ",
+                                                     FeatureMethodName(collection.global->method()),
+                                                     " descriptors of ",
+                                                     collection.global->dimension()));
     }
     return absl::OkStatus();
   }
@@ -157,8 +167,8 @@ absl::Status IndexService::Place(Collection* collection,
                                  const std::string& label,
                                  const Signature& signature) {
   MESHSEEK_RETURN_IF_ERROR(CheckFits(*collection, model_id, signature));
-  const bool fresh = collection->docs.empty() || (collection->docs.size() == 1 &&
-                                                  collection->docs.contains(model_id));
+  const bool fresh = collection->docs.empty() ||
+                     (collection->docs.size() == 1 && collection->docs.contains(model_id));
   if (signature.descriptor.has_value()) {
     const std::string& data = signature.descriptor->data();
     if (fresh || !collection->global.has_value()) {
@@ -174,7 +184,8 @@ absl::Status IndexService::Place(Collection* collection,
     auto [it, inserted] = collection->docs.try_emplace(model_id, collection->next_doc);
     if (inserted) ++collection->next_doc;
     MESHSEEK_RETURN_IF_ERROR(collection->global->Upsert(
-        it->second, absl::MakeConstSpan(reinterpret_cast<const uint8_t*>(data.data()), data.size())));
+        it->second,
+        absl::MakeConstSpan(reinterpret_cast<const uint8_t*>(data.data()), data.size())));
     collection->models[it->second] = Model{model_id, ordinal, label};
     return absl::OkStatus();
   }
@@ -205,8 +216,10 @@ grpc::Status IndexService::AddModel(grpc::ServerContext*,
     return InvalidArgument("add: collection and model_id must not be empty");
   }
   const std::string name = absl::StrCat("add model '", request->model_id(), "'");
-  absl::StatusOr<Signature> signature = ParseSignature(
-      request->histogram(), request->has_global_descriptor() ? &request->global_descriptor() : nullptr, name);
+  absl::StatusOr<Signature> signature =
+      ParseSignature(request->histogram(),
+                     request->has_global_descriptor() ? &request->global_descriptor() : nullptr,
+                     name);
   if (!signature.ok()) return rpc::ToGrpcStatus(signature.status());
   absl::MutexLock write(&write_mutex_);
   {
@@ -223,22 +236,23 @@ grpc::Status IndexService::AddModel(grpc::ServerContext*,
   absl::StatusOr<Statement> upsert = db_->Prepare(
       "INSERT OR REPLACE INTO models (collection, model_id, ordinal, label, histogram, "
       "descriptor) VALUES (?, ?, ?, ?, ?, ?)");
-  absl::Status stored =
-      upsert.ok() ? upsert->Bind(1, request->collection())
-                        .Bind(2, request->model_id())
-                        .Bind(3, static_cast<int64_t>(request->ordinal()))
-                        .Bind(4, request->label())
-                        .BindBlob(5, request->histogram().SerializeAsString())
-                        .BindBlob(6, request->has_global_descriptor()
-                                         ? request->global_descriptor().SerializeAsString()
-                                         : std::string())
-                        .Run()
-                  : upsert.status();
+  absl::Status stored = upsert.ok()
+                            ? upsert->Bind(1, request->collection())
+                                  .Bind(2, request->model_id())
+                                  .Bind(3, static_cast<int64_t>(request->ordinal()))
+                                  .Bind(4, request->label())
+                                  .BindBlob(5, request->histogram().SerializeAsString())
+                                  .BindBlob(6,
+                                            request->has_global_descriptor()
+                                                ? request->global_descriptor().SerializeAsString()
+                                                : std::string())
+                                  .Run()
+                            : upsert.status();
   if (!stored.ok()) return rpc::ToGrpcStatus(stored);
   absl::MutexLock lock(&mutex_);
   Collection& collection = collections_[request->collection()];
-  const absl::Status placed = Place(&collection, request->model_id(), request->ordinal(),
-                                    request->label(), *signature);
+  const absl::Status placed =
+      Place(&collection, request->model_id(), request->ordinal(), request->label(), *signature);
   if (!placed.ok()) return rpc::ToGrpcStatus(placed);  // checked above: not reached
   response->set_collection_size(collection.docs.size());
   return grpc::Status::OK;
@@ -334,7 +348,8 @@ grpc::Status IndexService::Search(grpc::ServerContext*,
   if (request->top_k() == 0) return InvalidArgument("search: top_k must be at least 1");
   absl::StatusOr<Signature> query =
       ParseSignature(request->histogram(),
-                     request->has_global_descriptor() ? &request->global_descriptor() : nullptr, "search: query");
+                     request->has_global_descriptor() ? &request->global_descriptor() : nullptr,
+                     "search: query");
   if (!query.ok()) return rpc::ToGrpcStatus(query.status());
   if (!query->descriptor.has_value()) UseEpsilon(request->collection(), request->kl_epsilon());
   absl::ReaderMutexLock lock(&mutex_);
@@ -348,10 +363,12 @@ grpc::Status IndexService::Search(grpc::ServerContext*,
       request->candidates() == 0 ? 0 : std::max(request->candidates(), request->top_k());
   absl::StatusOr<std::vector<KlNeighbor>> found =
       query->descriptor.has_value()
-          ? (*collection)->global->Search(AsBytes(query->descriptor->data()), request->top_k(),
-                                          options_.num_threads)
-          : (*collection)->engine->Search(query->histogram, request->top_k(),
-                                          options_.num_threads, candidates);
+          ? (*collection)
+                ->global->Search(
+                    AsBytes(query->descriptor->data()), request->top_k(), options_.num_threads)
+          : (*collection)
+                ->engine->Search(
+                    query->histogram, request->top_k(), options_.num_threads, candidates);
   if (!found.ok()) return rpc::ToGrpcStatus(found.status());
   // The engine breaks ties by doc and returns every model tied with the k-th:
   // rank ties by ordinal (then id) as the whole collection would be.
@@ -428,8 +445,8 @@ grpc::Status IndexService::Distances(grpc::ServerContext*,
                                      v1::DistancesResponse* response) {
   const int total = request->queries_size() + request->global_queries_size();
   if (total > kMaxDistanceQueries) {
-    return InvalidArgument(absl::StrCat("distances: ", total, " queries, at most ",
-                                        kMaxDistanceQueries, " per request"));
+    return InvalidArgument(absl::StrCat(
+        "distances: ", total, " queries, at most ", kMaxDistanceQueries, " per request"));
   }
   if (request->queries_size() > 0 && request->global_queries_size() > 0) {
     return InvalidArgument("distances: both histogram and descriptor queries");
@@ -442,9 +459,8 @@ grpc::Status IndexService::Distances(grpc::ServerContext*,
     queries.push_back(*std::move(query));
   }
   for (int q = 0; q < request->global_queries_size(); ++q) {
-    absl::StatusOr<Signature> query =
-        ParseSignature(v1::SparseHistogram(), &request->global_queries(q),
-                       absl::StrCat("distances: query ", q));
+    absl::StatusOr<Signature> query = ParseSignature(
+        v1::SparseHistogram(), &request->global_queries(q), absl::StrCat("distances: query ", q));
     if (!query.ok()) return rpc::ToGrpcStatus(query.status());
     queries.push_back(*std::move(query));
   }
