@@ -7,8 +7,14 @@
 //
 // Extracts once per scale E and reuses the features for every vocabulary
 // size V and KL epsilon; prints one row per (E, V, epsilon) and appends it to
-// --csv.
+// --csv. Methods without a scale knob (bfdsift, lsf) ignore --scales.
+// --features_cache FILE keeps the extracted features of a run (one scale) in
+// FILE and reads them back on the next run instead of extracting: sweeps of
+// the codebook and histogram stages then cost no extraction. The file is not
+// checked against the extraction flags: one file per extraction setting.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <opencv2/core.hpp>
@@ -26,8 +32,9 @@
 ABSL_FLAG(std::string, manifest, "", "CSV manifest id,class,path");
 ABSL_FLAG(std::string,
           scales,
-          "0.2",
-          "comma-separated scales: E for --method dld, C (scale factor) for ld and rld");
+          "",
+          "comma-separated scales: E for --method dld, C (scale factor) for ld and rld "
+          "(default: the method's shipped one)");
 ABSL_FLAG(std::string,
           vocabularies,
           "",
@@ -35,6 +42,17 @@ ABSL_FLAG(std::string,
 ABSL_FLAG(std::string, epsilons, "", "comma-separated KL epsilons (default: the shipped one)");
 ABSL_FLAG(std::string, csv, "", "append result rows to this CSV file");
 ABSL_FLAG(std::string, tag, "", "free text copied into the CSV rows");
+ABSL_FLAG(std::string,
+          features_cache,
+          "",
+          "read the features from this file if it exists, else extract and write them there");
+ABSL_FLAG(std::string, weightings, "none", "experimental: comma-separated none|idf|pow0.5|idfpow0.5");
+ABSL_FLAG(std::string, distances, "kl", "experimental: comma-separated kl|l1|l2|hell");
+ABSL_FLAG(std::string,
+          keep_levels,
+          "",
+          "comma-separated keypoint levels to keep (BF-DSIFT: patch scale index), all if empty; "
+          "one extraction at several scales then measures every subset");
 
 namespace {
 
@@ -50,6 +68,107 @@ std::vector<T> ParseList(const std::string& text) {
     values.push_back(static_cast<T>(v));
   }
   return values;
+}
+
+// The cache file: "MSFC", model count, then per model the keypoint count,
+// the descriptor dimension, the keypoints and the descriptors, raw.
+bool WriteFeatures(const std::string& path, const std::vector<meshseek::LocalFeatures>& all) {
+  std::ofstream out(path, std::ios::binary);
+  const auto put = [&](const void* p, std::size_t n) {
+    out.write(static_cast<const char*>(p), static_cast<std::streamsize>(n));
+  };
+  const uint64_t count = all.size();
+  put("MSFC", 4);
+  put(&count, sizeof count);
+  for (const meshseek::LocalFeatures& f : all) {
+    const uint64_t header[2] = {f.keypoints.size(), f.dimension};
+    put(header, sizeof header);
+    put(f.keypoints.data(), f.keypoints.size() * sizeof(meshseek::Keypoint));
+    put(f.descriptors.data(), f.descriptors.size());
+  }
+  return static_cast<bool>(out);
+}
+
+bool ReadFeatures(const std::string& path, std::vector<meshseek::LocalFeatures>* all) {
+  std::ifstream in(path, std::ios::binary);
+  const auto get = [&](void* p, std::size_t n) {
+    return static_cast<bool>(in.read(static_cast<char*>(p), static_cast<std::streamsize>(n)));
+  };
+  char magic[4];
+  uint64_t count = 0;
+  if (!get(magic, 4) || std::string(magic, 4) != "MSFC" || !get(&count, sizeof count)) return false;
+  all->resize(count);
+  for (meshseek::LocalFeatures& f : *all) {
+    uint64_t header[2];
+    if (!get(header, sizeof header) || header[0] > (1u << 24) ||
+        header[1] > meshseek::kMaxDescriptorDimension)
+      return false;
+    f.keypoints.resize(header[0]);
+    f.dimension = header[1];
+    f.descriptors.resize(header[0] * header[1]);
+    if (!get(f.keypoints.data(), f.keypoints.size() * sizeof(meshseek::Keypoint)) ||
+        !get(f.descriptors.data(), f.descriptors.size()))
+      return false;
+  }
+  return true;
+}
+
+// Experimental histogram weighting (before the shipped one exists): "idf"
+// multiplies bin k by ln(N / df_k), "pow<a>" raises bins to a, "idfpow<a>"
+// both; results renormalised to sum 1.
+void WeightHistograms(const std::string& mode, std::vector<std::vector<float>>* hs) {
+  if (mode.empty() || mode == "none") return;
+  const std::size_t n = hs->size(), v = (*hs)[0].size();
+  std::vector<double> idf(v, 1.0);
+  bool use_idf = mode.rfind("idf", 0) == 0;
+  double power = 1.0;
+  const std::size_t at = mode.find("pow");
+  if (at != std::string::npos) power = std::stod(mode.substr(at + 3));
+  if (use_idf) {
+    std::vector<int> df(v, 0);
+    for (const auto& h : *hs)
+      for (std::size_t k = 0; k < h.size(); ++k) df[k] += h[k] > 0;
+    for (std::size_t k = 0; k < v; ++k) idf[k] = df[k] ? std::log(double(n) / df[k]) + 1e-3 : 0;
+  }
+  for (auto& h : *hs) {
+    double sum = 0;
+    for (std::size_t k = 0; k < h.size(); ++k) {
+      if (h[k] <= 0) continue;
+      h[k] = static_cast<float>(std::pow(h[k] * idf[k], power));
+      sum += h[k];
+    }
+    if (sum > 0)
+      for (float& x : h) x = static_cast<float>(x / sum);
+  }
+}
+
+// Experimental distances on dense histograms: "l1", "l2" (of L2-normalised
+// vectors, i.e. cosine), "hell" (L2 of square roots).
+std::vector<float> DenseDistances(const std::string& kind, std::vector<std::vector<float>> hs) {
+  const std::size_t n = hs.size();
+  for (auto& h : hs) {
+    if (kind == "hell") {
+      for (float& x : h) x = std::sqrt(x);
+    } else if (kind == "l2") {
+      double s = 0;
+      for (float x : h) s += double(x) * x;
+      s = std::sqrt(s);
+      if (s > 0)
+        for (float& x : h) x = static_cast<float>(x / s);
+    }
+  }
+  std::vector<float> d(n * n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      double s = 0;
+      for (std::size_t k = 0; k < hs[i].size(); ++k) {
+        const double t = double(hs[i][k]) - hs[j][k];
+        s += kind == "l1" ? std::abs(t) : t * t;
+      }
+      d[i * n + j] = d[j * n + i] = static_cast<float>(s);
+    }
+  }
+  return d;
 }
 
 }  // namespace
@@ -78,29 +197,60 @@ int main(int argc, char** argv) {
       "tag,scale,V,epsilon,RP_excl_micro,RP_excl_macro,RP_incl_micro,NN_micro,ST_micro,DCG_micro,"
       "extract_s\n");
   std::vector<double> scales = ParseList<double>(absl::GetFlag(FLAGS_scales));
+  const FeatureMethod method = options.extractor.method;
+  const bool has_scale = method == FeatureMethod::kDldSift || method == FeatureMethod::kLdSift ||
+                         method == FeatureMethod::kRldSift;
+  if (!has_scale) scales = {0};
   if (scales.empty()) {
-    switch (options.extractor.method) {
-      case FeatureMethod::kDldSift:
-        scales.push_back(options.extractor.dld.scale);
-        break;
-      case FeatureMethod::kLdSift:
-        scales.push_back(options.extractor.ld.scale_space.scale_factor);
-        break;
-      case FeatureMethod::kRldSift:
-        scales.push_back(options.extractor.rld.scale_space.scale_factor);
-        break;
-    }
+    scales.push_back(method == FeatureMethod::kDldSift ? options.extractor.dld.scale
+                     : method == FeatureMethod::kLdSift
+                         ? options.extractor.ld.scale_space.scale_factor
+                         : options.extractor.rld.scale_space.scale_factor);
+  }
+  const std::string cache = absl::GetFlag(FLAGS_features_cache);
+  if (!cache.empty() && scales.size() != 1) {
+    std::fprintf(stderr, "--features_cache takes one scale\n");
+    return 2;
   }
   for (double scale : scales) {
     // The method's scale knob: E for DLD-SIFT, C for the scale-space methods.
-    options.extractor.dld.scale = scale;
-    options.extractor.ld.scale_space.scale_factor = scale;
-    options.extractor.rld.scale_space.scale_factor = scale;
+    if (has_scale) {
+      options.extractor.dld.scale = scale;
+      options.extractor.ld.scale_space.scale_factor = scale;
+      options.extractor.rld.scale_space.scale_factor = scale;
+    }
     const auto start = std::chrono::steady_clock::now();
-    auto features = ExtractCollection(*models, options);
-    if (!features.ok()) {
-      std::fprintf(stderr, "%s\n", features.status().ToString().c_str());
-      return 1;
+    absl::StatusOr<std::vector<LocalFeatures>> features;
+    if (!cache.empty() && std::ifstream(cache).good()) {
+      features.emplace();
+      if (!ReadFeatures(cache, &*features)) {
+        std::fprintf(stderr, "cannot read features cache %s\n", cache.c_str());
+        return 1;
+      }
+    } else {
+      features = ExtractCollection(*models, options);
+      if (!features.ok()) {
+        std::fprintf(stderr, "%s\n", features.status().ToString().c_str());
+        return 1;
+      }
+      if (!cache.empty() && !WriteFeatures(cache, *features)) {
+        std::fprintf(stderr, "cannot write features cache %s\n", cache.c_str());
+        return 1;
+      }
+    }
+    const std::vector<int> keep = ParseList<int>(absl::GetFlag(FLAGS_keep_levels));
+    if (!keep.empty()) {
+      for (LocalFeatures& f : *features) {
+        LocalFeatures kept;
+        kept.dimension = f.dimension;
+        for (std::size_t i = 0; i < f.size(); ++i) {
+          if (std::find(keep.begin(), keep.end(), f.keypoints[i].level) == keep.end()) continue;
+          kept.keypoints.push_back(f.keypoints[i]);
+          kept.descriptors.insert(
+              kept.descriptors.end(), f.descriptor(i), f.descriptor(i) + f.dimension);
+        }
+        f = std::move(kept);
+      }
     }
     const double extract_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -113,13 +263,22 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", codebook.status().ToString().c_str());
         return 1;
       }
-      auto histograms = EncodeCollection(*codebook, *features, options);
-      for (double eps : epsilons) {
-        options.kl.epsilon = eps;
-        auto distances = RankCollection(*histograms, options);
-        auto metrics = EvaluateRetrieval(labels, *distances, options.num_threads);
-        const std::string row = absl::StrFormat("%s,%g,%d,%g,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.1f",
-                                                absl::GetFlag(FLAGS_tag),
+      const auto encoded = EncodeCollection(*codebook, *features, options);
+      for (absl::string_view weighting : absl::StrSplit(absl::GetFlag(FLAGS_weightings), ',')) {
+      for (absl::string_view distance : absl::StrSplit(absl::GetFlag(FLAGS_distances), ',')) {
+      for (double eps : distance == "kl" ? epsilons : std::vector<double>{0}) {
+        std::vector<std::vector<float>> histograms = *encoded;
+        WeightHistograms(std::string(weighting), &histograms);
+        std::vector<float> matrix;
+        if (distance == "kl") {
+          options.kl.epsilon = eps;
+          matrix = *RankCollection(histograms, options);
+        } else {
+          matrix = DenseDistances(std::string(distance), histograms);
+        }
+        auto metrics = EvaluateRetrieval(labels, matrix, options.num_threads);
+        const std::string row = absl::StrFormat("%s %s %s,%g,%d,%g,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.1f",
+                                                absl::GetFlag(FLAGS_tag), weighting, distance,
                                                 scale,
                                                 v,
                                                 eps,
@@ -134,6 +293,8 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
         if (!absl::GetFlag(FLAGS_csv).empty())
           std::ofstream(absl::GetFlag(FLAGS_csv), std::ios::app) << row << "\n";
+      }
+      }
       }
     }
   }

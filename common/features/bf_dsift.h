@@ -48,16 +48,29 @@ struct BfDsiftOptions {
   /// Smallest patch radius relative to the view's side (the view spans the
   /// enclosing sphere's diameter).
   double patch_radius = 0.05;
-  /// Radii per point: patch_radius, 2 patch_radius, ... (1 to 4). Three
-  /// (0.05, 0.1, 0.2) measured best: 74.0 against 72.4 for 0.15 alone and
-  /// 73.3 for four from 0.04.
-  int patch_scales = 3;
+  /// Radii per point: patch_radius, 2 patch_radius, ... (1 to 4). Four
+  /// (0.05 to 0.4) by measurement (bench/results/bfdsift.txt): PSB's rigid
+  /// shapes need the largest, which covers most of the model (PSB train 50.5
+  /// against 48.5 for three), and at V = 40,000 McGill's articulated ones
+  /// lose nothing by it (76.9 with four or three); with one radius the best
+  /// (0.15) is 2 points below three.
+  int patch_scales = 4;
   /// The local depth image each patch is resampled into (size I, odd).
   DepthImageOptions patch_image;
-  /// SIFT of each patch: Lowe's dominant orientations.
-  SiftDescriptorOptions descriptor;
+  /// SIFT of each patch: Lowe's dominant orientation, the strongest peak
+  /// only. Every peak within 80 % (one descriptor per peak, as the local
+  /// methods) measured 1.5 below on McGill (74.0 against 75.5 at V = 8,000):
+  /// a patch with a second peak would count twice in the histogram.
+  SiftDescriptorOptions descriptor = OneOrientation();
 
   absl::Status Validate() const;
+
+ private:
+  static SiftDescriptorOptions OneOrientation() {
+    SiftDescriptorOptions sift;
+    sift.max_orientations = 1;
+    return sift;
+  }
 };
 
 /// The dense SIFT features of every view of `mesh`. Keypoints: position = the

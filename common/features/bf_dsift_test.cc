@@ -17,9 +17,10 @@ TEST(BfDsiftOptionsTest, DefaultsArePinnedAndValid) {
   EXPECT_EQ(options.view_size, 128);
   EXPECT_EQ(options.points_per_view, 150);
   EXPECT_EQ(options.patch_radius, 0.05);
-  EXPECT_EQ(options.patch_scales, 3);
+  EXPECT_EQ(options.patch_scales, 4);
   EXPECT_EQ(options.patch_image.image_size, 21);
   EXPECT_EQ(options.descriptor.orientation, ImageOrientation::kDominant);
+  EXPECT_EQ(options.descriptor.max_orientations, 1);
 }
 
 TEST(BfDsiftOptionsTest, RejectsBadValuesWithTheirValue) {

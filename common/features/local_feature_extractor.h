@@ -44,6 +44,9 @@ struct FeatureMethodInfo {
   /// The codebook size measured best for its features (bag of features;
   /// 0 for a global method).
   int vocabulary;
+  /// k-means trains on at most this many of the features per word
+  /// (KMeansOptions::max_points_per_centroid; 0 for a global method).
+  int kmeans_points_per_centroid;
   /// Validates the method's options in ExtractorOptions.
   absl::Status (*validate)(const ExtractorOptions& options);
   /// Extracts one mesh's features (see ExtractLocalFeatures).

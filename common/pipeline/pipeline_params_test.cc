@@ -20,12 +20,17 @@ TEST(PipelineParamsTest, EveryMethodIsRegisteredOnceWithValidDefaults) {
     EXPECT_TRUE(options.Validate().ok()) << info.name << ": " << options.Validate();
     if (info.kind == DescriptorKind::kBagOfFeatures) {
       EXPECT_EQ(options.kmeans.num_centroids, info.vocabulary);
+      EXPECT_EQ(options.kmeans.max_points_per_centroid, info.kmeans_points_per_centroid);
     } else {
       EXPECT_GT(info.descriptor_bytes, 0u);
       EXPECT_NE(info.distance, nullptr);
     }
   }
   EXPECT_FALSE(ParseFeatureMethod("sift").ok());
+  // BF-DSIFT's codebook, measured (bench/results/bfdsift.txt).
+  const RetrievalPipelineOptions bf = RetrievalPipelineOptions::ForMethod(FeatureMethod::kBfDsift);
+  EXPECT_EQ(bf.kmeans.num_centroids, 40000);
+  EXPECT_EQ(bf.kmeans.max_points_per_centroid, 50);
 }
 
 TEST(PipelineParamsTest, NamesAreUniqueAndEveryDefaultLiesInItsOwnRange) {

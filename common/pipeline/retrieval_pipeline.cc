@@ -32,9 +32,10 @@ RetrievalPipelineOptions::RetrievalPipelineOptions() {
   // Measured on McGill articulated and PSB train (README, bench/results):
   // V = 2,000 is at or near the best on both; 100 training features per
   // centroid cost 0.2 points of R-precision against 256 (below the spread
-  // between k-means seeds) and make k-means 2.5 times faster.
+  // between k-means seeds) and make k-means 2.5 times faster. Other methods
+  // have their own measured figures (FeatureMethodInfo).
   kmeans.num_centroids = FeatureMethodInfoOf(extractor.method).vocabulary;
-  kmeans.max_points_per_centroid = 100;
+  kmeans.max_points_per_centroid = FeatureMethodInfoOf(extractor.method).kmeans_points_per_centroid;
 }
 
 RetrievalPipelineOptions RetrievalPipelineOptions::ForMethod(FeatureMethod method) {
@@ -43,6 +44,8 @@ RetrievalPipelineOptions RetrievalPipelineOptions::ForMethod(FeatureMethod metho
   // A global method has no codebook: the (unused) default stays.
   if (FeatureMethodInfoOf(method).vocabulary > 0) {
     options.kmeans.num_centroids = FeatureMethodInfoOf(method).vocabulary;
+    options.kmeans.max_points_per_centroid =
+        FeatureMethodInfoOf(method).kmeans_points_per_centroid;
   }
   return options;
 }
