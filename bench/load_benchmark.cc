@@ -159,7 +159,7 @@ absl::Status CreateCollection(v1::Coordinator::Stub* stub, const std::string& na
   rpc::SetDeadline(&context, absl::Minutes(1));
   v1::CreateCollectionRequest request;
   request.set_name(name);
-  MESHSEEK_ASSIGN_OR_RETURN(*request.mutable_params(), cli::PipelineParamsFromFlags());
+  MESHSEEK_ASSIGN_OR_RETURN(*request.mutable_params(), cli::CollectionParamsFromFlags());
   v1::Collection response;
   return rpc::FromGrpcStatus(stub->CreateCollection(&context, request, &response));
 }

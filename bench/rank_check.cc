@@ -20,6 +20,7 @@
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "cli/pipeline_flags.h"
+#include "common/eval/retrieval_metrics.h"
 #include "common/pipeline/retrieval_pipeline.h"
 #include "common/search/kl_inverted_index.h"
 

@@ -27,6 +27,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "cli/pipeline_flags.h"
+#include "common/eval/retrieval_metrics.h"
 #include "common/pipeline/retrieval_pipeline.h"
 
 ABSL_FLAG(std::string, manifest, "", "CSV manifest id,class,path");

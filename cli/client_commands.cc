@@ -12,6 +12,7 @@
 #include "absl/flags/declare.h"
 #include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/clock.h"
 #include "cli/commands.h"
@@ -276,7 +277,7 @@ absl::Status IngestModels(v1::Coordinator::Stub* stub, const std::string& collec
 absl::Status EnsureCollection(v1::Coordinator::Stub* stub, const std::string& name) {
   v1::CreateCollectionRequest create;
   create.set_name(name);
-  MESHSEEK_ASSIGN_OR_RETURN(*create.mutable_params(), PipelineParamsFromFlags());
+  MESHSEEK_ASSIGN_OR_RETURN(*create.mutable_params(), CollectionParamsFromFlags());
   v1::Collection collection;
   return Call(stub, &v1::Coordinator::Stub::CreateCollection, create, &collection);
 }
@@ -406,7 +407,7 @@ absl::Status RunServe() {
 bool EvalInProcess() { return absl::GetFlag(FLAGS_server) == "in-process"; }
 
 absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
-    const std::vector<ManifestEntry>& models, const RetrievalPipelineOptions& options,
+    const std::vector<ManifestEntry>& models, const CollectionOptions& options,
     const std::string& manifest_path) {
   const auto start = absl::Now();
   MESHSEEK_ASSIGN_OR_RETURN(auto session, Session::Open());
@@ -415,9 +416,9 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
   if (collection.empty()) {
     // Named after the manifest's folder, the method and a hash of the
     // parameters, so that evaluating again reuses the extracted models.
-    // The canonical parameters (every one of the method, by name).
+    // The canonical parameters (every one of the collection, by name).
     v1::PipelineParams canonical;
-    rpc::PipelineParamsToProto(options, &canonical);
+    rpc::CollectionParamsToProto(options, &canonical);
     const std::string params = canonical.SerializeAsString();
     std::string folder = std::filesystem::absolute(manifest_path).parent_path().filename().string();
     for (char& c : folder) {
@@ -426,7 +427,7 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
     collection = absl::StrCat(
         folder.empty() ? "eval" : folder,
         "-",
-        FeatureMethodName(options.extractor.method),
+        absl::StrReplaceAll(options.MethodName(), {{"+", "_"}}),
         "-",
         absl::Hex(Fnv1a64(params, kFnv1a64OffsetBasis) & 0xffffffffu, absl::kZeroPad8));
   }
@@ -454,7 +455,15 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
   const std::size_t n = models.size();
   evaluation.models = models;
   evaluation.distances.assign(n * n, 0.0f);
-  evaluation.features_per_model.assign(n, 0);
+  evaluation.methods.resize(options.methods.size());
+  for (std::size_t m = 0; m < options.methods.size(); ++m) {
+    MethodEvaluation& method = evaluation.methods[m];
+    method.method = options.methods[m].extractor.method;
+    method.features_per_model.assign(n, 0);
+    method.codebook_size = FeatureMethodInfoOf(method.method).kind == DescriptorKind::kGlobal
+                               ? 0
+                               : options.methods[m].kmeans.num_centroids;
+  }
   std::vector<std::string> row_ids;
   std::size_t rows = 0;
   MESHSEEK_RETURN_IF_ERROR(rpc::RetryTransient(
@@ -479,7 +488,14 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
           }
           row_ids.push_back(row.model_id());
           pending.emplace_back(it->second, std::vector<float>(row.distances().begin(), row.distances().end()));
-          evaluation.features_per_model[it->second] = row.features();
+          // One count per method (a row of a collection of one method may
+          // carry only `features`).
+          for (std::size_t m = 0; m < evaluation.methods.size(); ++m) {
+            evaluation.methods[m].features_per_model[it->second] =
+                m < static_cast<std::size_t>(row.method_features_size())
+                    ? row.method_features(static_cast<int>(m))
+                    : row.features();
+          }
           ++rows;
         }
         MESHSEEK_RETURN_IF_ERROR(rpc::FromGrpcStatus(reader->Finish()));
@@ -496,15 +512,13 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
     return absl::FailedPreconditionError(absl::StrCat("collection '", collection, "' has ", rows,
                                                       " models, the manifest ", n));
   }
-  for (std::size_t f : evaluation.features_per_model) evaluation.models_without_features += f == 0;
-  evaluation.codebook_size =
-      FeatureMethodInfoOf(options.extractor.method).kind == DescriptorKind::kGlobal
-          ? 0
-          : options.kmeans.num_centroids;
+  for (MethodEvaluation& method : evaluation.methods) {
+    for (std::size_t f : method.features_per_model) method.models_without_features += f == 0;
+  }
   std::vector<std::string> labels;
   for (const ManifestEntry& m : models) labels.push_back(m.label);
   MESHSEEK_ASSIGN_OR_RETURN(evaluation.metrics,
-                            EvaluateRetrieval(labels, evaluation.distances, options.num_threads));
+                            EvaluateRetrieval(labels, evaluation.distances, options.num_threads()));
   evaluation.timings.rank_seconds = absl::ToDoubleSeconds(absl::Now() - rank_start);
   evaluation.timings.total_seconds = absl::ToDoubleSeconds(absl::Now() - start);
   std::fprintf(stderr, "eval: collection '%s'\n", collection.c_str());

@@ -9,7 +9,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "common/pipeline/retrieval_pipeline.h"
+#include "common/pipeline/collection_evaluation.h"
 
 namespace meshseek::cli {
 
@@ -25,7 +25,7 @@ absl::Status RunServe();
 bool EvalInProcess();
 absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
     const std::vector<ManifestEntry>& models,
-    const RetrievalPipelineOptions& options,
+    const CollectionOptions& options,
     const std::string& manifest_path);
 absl::Status RunSynth();
 absl::Status RunInspect(const std::string& model_path);

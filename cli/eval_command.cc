@@ -4,11 +4,12 @@
 #include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "cli/commands.h"
 #include "cli/pipeline_flags.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
-#include "common/pipeline/retrieval_pipeline.h"
+#include "common/pipeline/collection_evaluation.h"
 
 ABSL_FLAG(std::string,
           manifest,
@@ -24,14 +25,14 @@ absl::Status RunEval() {
   if (manifest_path.empty()) return absl::InvalidArgumentError("eval needs --manifest FILE");
   if (out_dir.empty()) return absl::InvalidArgumentError("eval needs --out DIR");
 
-  MESHSEEK_ASSIGN_OR_RETURN(const RetrievalPipelineOptions options, PipelineOptionsFromFlags());
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromFlags());
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<ManifestEntry> models, ReadManifest(manifest_path));
   std::fprintf(stderr,
                "meshseek eval: %zu models from %s, method %s, %d threads\n",
                models.size(),
                manifest_path.c_str(),
-               FeatureMethodName(options.extractor.method),
-               ResolveThreadCount(options.num_threads));
+               options.MethodName().c_str(),
+               ResolveThreadCount(options.num_threads()));
   MESHSEEK_ASSIGN_OR_RETURN(const CollectionEvaluation evaluation,
                             EvalInProcess()
                                 ? EvaluateCollection(models, options)
@@ -43,10 +44,16 @@ absl::Status RunEval() {
   std::printf("R-precision (query excluded = first tier): %.1f %% micro, %.1f %% macro\n",
               100 * evaluation.metrics.micro.rp_excl,
               100 * evaluation.metrics.macro.rp_excl);
-  const std::string signature =
-      evaluation.codebook_size > 0
-          ? absl::StrCat("codebook V = ", evaluation.codebook_size)
-          : absl::StrCat("global descriptors of ", FeatureMethodName(options.extractor.method));
+  std::vector<std::string> signatures;
+  for (const MethodEvaluation& m : evaluation.methods) {
+    signatures.push_back(
+        m.codebook_size > 0
+            ? absl::StrCat(FeatureMethodName(m.method), " codebook V = ", m.codebook_size)
+            : absl::StrCat(FeatureMethodName(m.method), " global descriptors"));
+  }
+  std::string signature = absl::StrJoin(signatures, ", ");
+  if (options.fused()) absl::StrAppend(&signature, ", fused");
+  if (options.rerank.enabled()) absl::StrAppend(&signature, ", re-ranked");
   std::printf(EvalInProcess()
                   ? "%zu models, %s; time %.1f s (extract %.1f, codebook %.1f, encode %.1f, "
                     "rank %.1f)\n"

@@ -48,7 +48,7 @@ std::vector<char*> ParseCommandLineWithParams(int argc, char** argv, absl::strin
       name = name.substr(0, eq);
       has_value = true;
     }
-    if (FindPipelineParam(name) == nullptr) {
+    if (!IsPipelineParamName(name)) {
       rest.push_back(argv[i]);
       continue;
     }
@@ -67,23 +67,32 @@ std::vector<char*> ParseCommandLineWithParams(int argc, char** argv, absl::strin
   return absl::ParseCommandLine(rest_argc, rest.data());
 }
 
-absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags() {
+absl::StatusOr<CollectionOptions> CollectionOptionsFromFlags() {
   if (!MissingValue().empty()) {
     return absl::InvalidArgumentError(absl::StrCat("--", MissingValue(), " needs a value"));
   }
-  absl::StatusOr<RetrievalPipelineOptions> options = PipelineOptionsFromValues(GivenValues());
+  absl::StatusOr<CollectionOptions> options = CollectionOptionsFromValues(GivenValues());
   if (!options.ok()) {
     return absl::InvalidArgumentError(absl::StrCat("flags: ", options.status().message()));
   }
-  options->num_threads = absl::GetFlag(FLAGS_threads);
-  options->show_progress = absl::GetFlag(FLAGS_progress);
+  options->SetRunOptions(absl::GetFlag(FLAGS_threads), absl::GetFlag(FLAGS_progress));
   return options;
 }
 
-absl::StatusOr<v1::PipelineParams> PipelineParamsFromFlags() {
-  MESHSEEK_ASSIGN_OR_RETURN(const RetrievalPipelineOptions options, PipelineOptionsFromFlags());
+absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags() {
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromFlags());
+  if (options.fused() || options.rerank.enabled()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "flags: this command works with one method, got --method ", options.MethodName(),
+        options.rerank.enabled() ? " with --rerank" : ""));
+  }
+  return options.methods.front();
+}
+
+absl::StatusOr<v1::PipelineParams> CollectionParamsFromFlags() {
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromFlags());
   v1::PipelineParams params;
-  rpc::PipelineParamsToProto(options, &params);
+  rpc::CollectionParamsToProto(options, &params);
   return params;
 }
 

@@ -12,6 +12,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "common/pipeline/collection_options.h"
 #include "common/pipeline/retrieval_pipeline.h"
 #include "meshseek/v1/types.pb.h"
 
@@ -23,14 +24,18 @@ namespace meshseek::cli {
 // arguments, argv[0] first.
 std::vector<char*> ParseCommandLineWithParams(int argc, char** argv, absl::string_view usage);
 
-// The collection parameters from the flags, canonical (every parameter of
-// the method, rpc::PipelineParamsToProto), for CreateCollection; or the
-// error of PipelineOptionsFromFlags.
-absl::StatusOr<v1::PipelineParams> PipelineParamsFromFlags();
+// The collection parameters from the flags, canonical (every parameter,
+// rpc::CollectionParamsToProto), for CreateCollection; or the error of
+// CollectionOptionsFromFlags.
+absl::StatusOr<v1::PipelineParams> CollectionParamsFromFlags();
 
 // Options from the parameter flags (--method, --scale, --points, --vocabulary,
-// ...) and --threads / --progress, validated: InvalidArgument names the bad
-// parameter and value.
+// --rld.vocabulary, --weights, --rerank, ...) and --threads / --progress,
+// validated: InvalidArgument names the bad parameter and value.
+absl::StatusOr<CollectionOptions> CollectionOptionsFromFlags();
+
+// The same for commands that work with one method (inspect, bench tools):
+// InvalidArgument when the flags name several or ask for re-ranking.
 absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags();
 
 }  // namespace meshseek::cli

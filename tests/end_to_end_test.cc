@@ -12,7 +12,7 @@
 
 #include "common/base/file_io.h"
 #include "common/eval/distance_matrix.h"
-#include "common/pipeline/retrieval_pipeline.h"
+#include "common/pipeline/collection_evaluation.h"
 #include "common/synth/synthetic_benchmark.h"
 
 namespace meshseek {
@@ -64,7 +64,7 @@ TEST_F(EndToEndTest, PipelineRanksSyntheticClassesWellAboveChance) {
   auto models = ReadManifest(*dir_ + "/bench/manifest.csv");
   ASSERT_TRUE(models.ok()) << models.status();
   ASSERT_EQ(models->size(), 72u);
-  auto evaluation = EvaluateCollection(*models, SmallOptions());
+  auto evaluation = EvaluateCollection(*models, CollectionOptions::Of(SmallOptions()));
   ASSERT_TRUE(evaluation.ok()) << evaluation.status();
   // Chance first tier is 7/71 (10 %). The shapes are built to be told apart by
   // local surface shape, with soups, several components and sparse and dense
@@ -72,13 +72,13 @@ TEST_F(EndToEndTest, PipelineRanksSyntheticClassesWellAboveChance) {
   EXPECT_GT(evaluation->metrics.micro.rp_excl, 0.6);
   EXPECT_GT(evaluation->metrics.micro.nn, 0.8);
   EXPECT_EQ(evaluation->metrics.queries, 72u);
-  for (std::size_t n : evaluation->features_per_model) EXPECT_GT(n, 400u);
+  for (std::size_t n : evaluation->methods[0].features_per_model) EXPECT_GT(n, 400u);
 
   // The same run twice gives the same matrix: extraction, k-means and ranking
   // are deterministic whatever the thread count.
   RetrievalPipelineOptions one_thread = SmallOptions();
   one_thread.num_threads = 1;
-  auto again = EvaluateCollection(*models, one_thread);
+  auto again = EvaluateCollection(*models, CollectionOptions::Of(one_thread));
   ASSERT_TRUE(again.ok());
   EXPECT_EQ(again->distances, evaluation->distances);
 }

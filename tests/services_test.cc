@@ -23,7 +23,7 @@
 #include "absl/time/clock.h"
 #include "common/eval/manifest.h"
 #include "common/geometry/mesh_io.h"
-#include "common/pipeline/retrieval_pipeline.h"
+#include "common/pipeline/collection_evaluation.h"
 #include "common/rpc/client.h"
 #include "common/rpc/free_port.h"
 #include "common/rpc/convert.h"
@@ -221,7 +221,7 @@ class ServicesTest : public ::testing::Test {
     models_ = new std::vector<ManifestEntry>(*models);
     auto options = rpc::PipelineOptionsFromParams(TestParams());
     ASSERT_TRUE(options.ok());
-    auto reference = EvaluateCollection(*models_, *options);
+    auto reference = EvaluateCollection(*models_, CollectionOptions::Of(*options));
     ASSERT_TRUE(reference.ok()) << reference.status();
     reference_ = new std::vector<float>(reference->distances);
   }
@@ -596,9 +596,9 @@ TEST_F(ServicesTest, AGlobalDescriptorCollectionSurvivesKillsAndEqualsInProcess)
   // slow under the sanitizers.
   const std::size_t n = models_->size() / 3;
   const std::vector<ManifestEntry> models(models_->begin(), models_->begin() + n);
-  auto reference = EvaluateCollection(models, *options);
+  auto reference = EvaluateCollection(models, CollectionOptions::Of(*options));
   ASSERT_TRUE(reference.ok()) << reference.status();
-  EXPECT_EQ(reference->codebook_size, 0u);
+  EXPECT_EQ(reference->methods[0].codebook_size, 0u);
 
   Stack stack(*dir_ + "/global", 1, 512, /*index_shards=*/2);
   ASSERT_TRUE(stack.WaitServing());

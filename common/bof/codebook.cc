@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/base/byte_order.h"
 #include "common/base/hash.h"
 #include "common/base/status_macros.h"
 
@@ -19,18 +20,6 @@ constexpr uint32_t kApproximateVersion = 2;
 constexpr std::size_t kHeaderBytes = 4 + 4 + 8 + 8;
 constexpr std::size_t kApproximateHeaderBytes = kHeaderBytes + 4 + 4;
 constexpr std::size_t kChecksumBytes = 8;
-
-void PutLittleEndian(uint64_t value, int bytes, std::string* out) {
-  for (int i = 0; i < bytes; ++i) out->push_back(static_cast<char>((value >> (8 * i)) & 0xff));
-}
-
-uint64_t GetLittleEndian(const char* p, int bytes) {
-  uint64_t value = 0;
-  for (int i = 0; i < bytes; ++i) {
-    value |= static_cast<uint64_t>(static_cast<unsigned char>(p[i])) << (8 * i);
-  }
-  return value;
-}
 
 absl::Status CheckCentroids(const std::vector<float>& centroids, std::size_t dim) {
   for (std::size_t i = 0; i < centroids.size(); ++i) {
@@ -161,11 +150,7 @@ std::string Codebook::Serialize() const {
     PutLittleEndian(static_cast<uint32_t>(approximate_->params().groups), 4, &out);
     PutLittleEndian(static_cast<uint32_t>(approximate_->params().probes), 4, &out);
   }
-  for (float v : centroids_) {
-    uint32_t bits;
-    std::memcpy(&bits, &v, sizeof(bits));
-    PutLittleEndian(bits, 4, &out);
-  }
+  for (float v : centroids_) PutFloat(v, &out);
   PutLittleEndian(Fnv1a64(out), 8, &out);
   return out;
 }
@@ -241,8 +226,7 @@ absl::StatusOr<Codebook> Codebook::Deserialize(absl::string_view bytes) {
   }
   std::vector<float> centroids(size * dim);
   for (std::size_t i = 0; i < centroids.size(); ++i) {
-    const uint32_t bits = static_cast<uint32_t>(GetLittleEndian(bytes.data() + header + 4 * i, 4));
-    std::memcpy(&centroids[i], &bits, sizeof(bits));
+    centroids[i] = GetFloat(bytes.data() + header + 4 * i);
   }
   return FromCentroids(std::move(centroids), dim, approximate);
 }

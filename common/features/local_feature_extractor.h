@@ -47,6 +47,10 @@ struct FeatureMethodInfo {
   /// k-means trains on at most this many of the features per word
   /// (KMeansOptions::max_points_per_centroid; 0 for a global method).
   int kmeans_points_per_centroid;
+  /// Its default weight in a fused collection (CollectionOptions::weights):
+  /// 2 for the methods strongest on the development sets (BF-DSIFT, RLD-SIFT),
+  /// 1 for the others (bench/results/fusion.txt).
+  double fusion_weight;
   /// Validates the method's options in ExtractorOptions.
   absl::Status (*validate)(const ExtractorOptions& options);
   /// Extracts one mesh's features (see ExtractLocalFeatures).

@@ -1,17 +1,21 @@
 #include "common/pipeline/pipeline_params.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 #include <set>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "common/base/status_macros.h"
+#include "common/search/neighbor_graph.h"
 #include "common/search/sparse_histogram.h"
 
 namespace meshseek {
@@ -135,6 +139,29 @@ ParamSpec Choice(std::string name,
   return spec;
 }
 
+// A parameter of the collection (fusion, re-ranking) stored in one field.
+template <typename T>
+ParamSpec CollectionField(std::string name,
+                          std::string doc,
+                          double min,
+                          double max,
+                          T& (*field)(CollectionOptions&)) {
+  ParamSpec spec;
+  spec.name = std::move(name);
+  spec.type = TypeOf<T>();
+  spec.doc = std::move(doc);
+  spec.min = min;
+  spec.max = max;
+  spec.scope = Scope::kCollection;
+  spec.collection_get = [field](const CollectionOptions& o) {
+    return Text(field(const_cast<CollectionOptions&>(o)));
+  };
+  spec.collection_set = [field](absl::string_view text, CollectionOptions* o) {
+    Parse(text, &field(*o));
+  };
+  return spec;
+}
+
 // The sub-options every SIFT method has, of the selected method.
 DepthImageOptions& DepthImage(Options& o) {
   switch (o.extractor.method) {
@@ -176,7 +203,8 @@ std::vector<ParamSpec> MakeSpecs() {
       method.choices.push_back(info.name);
       titles.push_back(absl::StrCat(info.name, " (", info.title, ")"));
     }
-    method.doc = absl::StrCat("feature method: ", absl::StrJoin(titles, " | "));
+    method.doc = absl::StrCat("feature method, or several joined by + (fused): ",
+                              absl::StrJoin(titles, " | "));
     method.get = [](const Options& o) {
       return std::string(FeatureMethodName(o.extractor.method));
     };
@@ -441,6 +469,56 @@ std::vector<ParamSpec> MakeSpecs() {
       bag,
       {},
       +[](Options& o) -> double& { return o.kl.epsilon; }));
+
+  // The collection's: how the methods' distances become one ranking.
+  specs.push_back(CollectionField<std::vector<double>>(
+      "weights",
+      "fusion weight of each method, in the order named (several methods)",
+      0,
+      1000,
+      +[](CollectionOptions& o) -> std::vector<double>& { return o.weights; }));
+  {
+    ParamSpec rerank;
+    rerank.name = "rerank";
+    rerank.type = ParamType::kChoice;
+    rerank.scope = Scope::kCollection;
+    rerank.doc =
+        "re-ranking over the collection's neighbour graph: none | kreciprocal (k-reciprocal "
+        "encoding)";
+    rerank.choices = {"none", "kreciprocal"};
+    rerank.collection_get = [](const CollectionOptions& o) {
+      return std::string(o.rerank.enabled() ? "kreciprocal" : "none");
+    };
+    rerank.collection_set = [](absl::string_view text, CollectionOptions* o) {
+      o->rerank.method = text == "kreciprocal" ? RerankOptions::Method::kKReciprocal
+                                               : RerankOptions::Method::kNone;
+    };
+    specs.push_back(std::move(rerank));
+  }
+  specs.push_back(CollectionField<int>(
+      "rerank_k1",
+      "re-ranking: neighbourhood whose reciprocal members describe a model",
+      1,
+      NeighborGraph::kMaxK - 1,
+      +[](CollectionOptions& o) -> int& { return o.rerank.k1; }));
+  specs.push_back(CollectionField<int>(
+      "rerank_k2",
+      "re-ranking: nearest models averaged in local query expansion (1: none)",
+      1,
+      NeighborGraph::kMaxK,
+      +[](CollectionOptions& o) -> int& { return o.rerank.k2; }));
+  specs.push_back(CollectionField<double>(
+      "rerank_lambda",
+      "re-ranking: weight of the original distance",
+      0,
+      1,
+      +[](CollectionOptions& o) -> double& { return o.rerank.lambda; }));
+  specs.push_back(CollectionField<int>(
+      "rerank_depth",
+      "re-ranking: models re-ranked per query",
+      1,
+      100000,
+      +[](CollectionOptions& o) -> int& { return o.rerank.depth; }));
   return specs;
 }
 
@@ -497,6 +575,8 @@ std::string MethodNames(const ParamSpec& spec) {
       return "every method";
     case Scope::kBagOfFeatures:
       return "bag-of-features methods";
+    case Scope::kCollection:
+      return "the collection";
     case Scope::kListed:
       break;
   }
@@ -517,6 +597,8 @@ bool ParamSpec::AppliesTo(FeatureMethod method) const {
       for (FeatureMethod m : methods) {
         if (m == method) return true;
       }
+      return false;
+    case Scope::kCollection:
       return false;
   }
   return false;
@@ -553,92 +635,201 @@ const ParamSpec* FindPipelineParam(absl::string_view name) {
   return nullptr;
 }
 
-absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromValues(const ParamValues& values) {
-  // The method decides every other parameter's default and meaning.
-  std::string method = FeatureMethodName(FeatureMethod::kDldSift);
+bool IsPipelineParamName(absl::string_view name) {
+  if (FindPipelineParam(name) != nullptr) return true;
+  const std::size_t dot = name.find('.');
+  if (dot == absl::string_view::npos) return false;
+  const ParamSpec* spec = FindPipelineParam(name.substr(dot + 1));
+  return ParseFeatureMethod(name.substr(0, dot)).ok() && spec != nullptr &&
+         spec->scope != Scope::kCollection && spec->name != "method";
+}
+
+absl::StatusOr<CollectionOptions> CollectionOptionsFromValues(const ParamValues& values) {
+  // The methods decide every other parameter's default and meaning.
+  std::string method_list = FeatureMethodName(FeatureMethod::kDldSift);
   for (const auto& [name, value] : values) {
-    if (name == "method") method = value;
+    if (name == "method") method_list = value;
   }
   const ParamSpec& method_spec = PipelineParamSpecs().front();
-  MESHSEEK_RETURN_IF_ERROR(CheckValue(method_spec, method));
-  Options options;
-  method_spec.set(method, &options);
+  std::vector<FeatureMethod> methods;
+  for (absl::string_view name : absl::StrSplit(method_list, '+')) {
+    MESHSEEK_RETURN_IF_ERROR(CheckValue(method_spec, name));
+    const FeatureMethod m = *ParseFeatureMethod(name);
+    if (std::find(methods.begin(), methods.end(), m) != methods.end()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("parameter method: '", name, "' is named twice in '", method_list, "'"));
+    }
+    methods.push_back(m);
+  }
+  if (methods.size() > CollectionOptions::kMaxMethods) {
+    return absl::InvalidArgumentError(absl::StrCat("parameter method: at most ",
+                                                   CollectionOptions::kMaxMethods,
+                                                   " methods, got ", methods.size()));
+  }
+  CollectionOptions options = CollectionOptions::ForMethods(methods);
   for (const auto& [name, value] : values) {
     if (name == "method") continue;
-    const ParamSpec* spec = FindPipelineParam(name);
-    if (spec == nullptr) {
+    // "rld.vocabulary": one method's; "vocabulary": every method's it applies to.
+    absl::string_view plain = name;
+    std::optional<FeatureMethod> only;
+    if (const std::size_t dot = plain.find('.'); dot != absl::string_view::npos) {
+      absl::StatusOr<FeatureMethod> m = ParseFeatureMethod(plain.substr(0, dot));
+      if (!m.ok()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("parameter ", name, ": ", m.status().message()));
+      }
+      if (std::find(methods.begin(), methods.end(), *m) == methods.end()) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "parameter ", name, ": method ", plain.substr(0, dot), " is not in '", method_list, "'"));
+      }
+      only = *m;
+      plain = plain.substr(dot + 1);
+    }
+    const ParamSpec* spec = FindPipelineParam(plain);
+    if (spec == nullptr || spec->name == "method" ||
+        (only.has_value() && spec->scope == Scope::kCollection)) {
       std::vector<std::string> known;
       for (const ParamSpec& s : PipelineParamSpecs()) known.push_back(s.name);
       return absl::InvalidArgumentError(
-          absl::StrCat("unknown parameter '", name, "' (known: ", absl::StrJoin(known, ", "), ")"));
+          absl::StrCat("unknown parameter '", name, "' (known: ", absl::StrJoin(known, ", "),
+                       "; a method's may be qualified: rld.vocabulary)"));
     }
-    if (!spec->AppliesTo(options.extractor.method)) {
+    MESHSEEK_RETURN_IF_ERROR(CheckValue(*spec, value));
+    if (spec->scope == Scope::kCollection) {
+      spec->collection_set(value, &options);
+      continue;
+    }
+    bool applied = false;
+    for (RetrievalPipelineOptions& m : options.methods) {
+      const FeatureMethod method = m.extractor.method;
+      if ((only.has_value() && method != *only) || !spec->AppliesTo(method)) continue;
+      spec->set(value, &m);
+      applied = true;
+    }
+    if (!applied) {
       return absl::InvalidArgumentError(absl::StrCat("parameter ",
                                                      name,
                                                      " does not apply to method ",
-                                                     method,
+                                                     only.has_value() ? FeatureMethodName(*only)
+                                                                      : method_list.c_str(),
                                                      " (it applies to ",
                                                      MethodNames(*spec),
                                                      ")"));
     }
-    MESHSEEK_RETURN_IF_ERROR(CheckValue(*spec, value));
-    spec->set(value, &options);
   }
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   return options;
 }
 
-ParamValues PipelineValuesOf(const RetrievalPipelineOptions& options) {
+ParamValues CollectionValuesOf(const CollectionOptions& options) {
   ParamValues values;
+  values.emplace_back("method", options.MethodName());
+  for (const RetrievalPipelineOptions& m : options.methods) {
+    const std::string prefix =
+        options.fused() ? absl::StrCat(FeatureMethodName(m.extractor.method), ".") : "";
+    for (const ParamSpec& spec : PipelineParamSpecs()) {
+      if (spec.name != "method" && spec.AppliesTo(m.extractor.method)) {
+        values.emplace_back(prefix + spec.name, spec.get(m));
+      }
+    }
+  }
   for (const ParamSpec& spec : PipelineParamSpecs()) {
-    if (spec.AppliesTo(options.extractor.method)) values.emplace_back(spec.name, spec.get(options));
+    if (spec.scope != Scope::kCollection) continue;
+    // Weights mean something with several methods; the re-ranking's own
+    // parameters when it is on.
+    if (spec.name == "weights" && !options.fused()) continue;
+    if (absl::StartsWith(spec.name, "rerank_") && !options.rerank.enabled()) continue;
+    values.emplace_back(spec.name, spec.collection_get(options));
   }
   return values;
 }
 
-Json PipelineParamsToJson(const RetrievalPipelineOptions& options) {
-  Json json = Json::MakeObject();
-  for (const ParamSpec& spec : PipelineParamSpecs()) {
-    if (!spec.AppliesTo(options.extractor.method)) continue;
-    const std::string text = spec.get(options);
+absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromValues(const ParamValues& values) {
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromValues(values));
+  if (options.fused() || options.rerank.enabled()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "parameters of one method were expected, got '", options.MethodName(), "'",
+        options.rerank.enabled() ? " with re-ranking" : ""));
+  }
+  return options.methods.front();
+}
+
+ParamValues PipelineValuesOf(const RetrievalPipelineOptions& options) {
+  return CollectionValuesOf(CollectionOptions::Of(options));
+}
+
+namespace {
+
+// Sets json[spec.name] to `text` as the spec's type.
+void SetTyped(const ParamSpec& spec, const std::string& text, Json* json) {
     switch (spec.type) {
       case ParamType::kInt:
       case ParamType::kUint64: {
         int64_t v = 0;
         if (absl::SimpleAtoi(text, &v)) {
-          json.Set(spec.name, v);
+          json->Set(spec.name, v);
         } else {
-          json.Set(spec.name, text);  // a uint64 beyond int64: exact as text
+          json->Set(spec.name, text);  // a uint64 beyond int64: exact as text
         }
         break;
       }
       case ParamType::kDouble: {
         double v = 0;
         (void)absl::SimpleAtod(text, &v);
-        json.Set(spec.name, v);
+        json->Set(spec.name, v);
         break;
       }
       case ParamType::kBool:
-        json.Set(spec.name, text == "true");
+        json->Set(spec.name, text == "true");
         break;
       case ParamType::kChoice:
-        json.Set(spec.name, text);
+        json->Set(spec.name, text);
         break;
       case ParamType::kDoubleList: {
-        Json& list = json.Set(spec.name, Json::MakeArray());
+        Json& list = json->Set(spec.name, Json::MakeArray());
         std::vector<double> values;
         Parse(text, &values);
         for (double v : values) list.Push(v);
         break;
       }
     }
+}
+
+}  // namespace
+
+Json PipelineParamsToJson(const RetrievalPipelineOptions& options) {
+  Json json = Json::MakeObject();
+  for (const ParamSpec& spec : PipelineParamSpecs()) {
+    if (spec.AppliesTo(options.extractor.method)) SetTyped(spec, spec.get(options), &json);
   }
   return json;
 }
 
+void AddCollectionParamsToJson(const CollectionOptions& options, Json* json) {
+  for (const auto& [name, value] : CollectionValuesOf(options)) {
+    const ParamSpec* spec = FindPipelineParam(name);
+    if (spec != nullptr && spec->scope == Scope::kCollection) SetTyped(*spec, value, json);
+  }
+}
+
 std::string PipelineParamsUsage() {
-  std::string usage = "Pipeline parameters (--name=value; each applies to the methods named):\n";
+  std::string usage =
+      "Pipeline parameters (--name=value; each applies to the methods named; with several\n"
+      "methods, --rld.vocabulary=3000 sets one method's):\n";
   for (const ParamSpec& spec : PipelineParamSpecs()) {
+    if (spec.scope == Scope::kCollection) {
+      // Defaults for one method and for several (a fusion).
+      const std::string one = spec.collection_get(CollectionOptions());
+      const std::string several = spec.collection_get(
+          CollectionOptions::ForMethods({FeatureMethod::kBfDsift, FeatureMethod::kRldSift}));
+      const std::string value =
+          spec.name == "weights" ? "1 for each method"
+          : one == several       ? one
+                                 : absl::StrCat("one method ", one, ", several ", several);
+      absl::StrAppend(&usage, "  --", spec.name, "  ", spec.TypeDescription(), "; ", spec.doc,
+                      "\n      the collection; default: ", value, "\n");
+      continue;
+    }
     // "default: 20" when every method has the same, else "default: rld 15, ld 20".
     std::vector<std::string> defaults;
     std::set<std::string> distinct;

@@ -1,6 +1,7 @@
 // The one description of every retrieval-pipeline parameter: its name, type,
 // range or choices, documentation, the methods it applies to and where it
-// lives in RetrievalPipelineOptions. Everything that names a parameter
+// lives in RetrievalPipelineOptions (a method's parameters) or
+// CollectionOptions (fusion and re-ranking). Everything that names a parameter
 // follows from this table: the CLI's flags and their help
 // (cli/pipeline_flags), the collection parameters of the services
 // (PipelineParams.values, rpc/convert), their validation and canonical form,
@@ -11,7 +12,14 @@
 //
 // Values travel as text ("1024", "0.2", "true", "dominant"), parsed by the
 // parameter's type and checked against its range, so that a new parameter
-// needs no new proto field. A parameter's default is its option struct's
+// needs no new proto field.
+//
+// Several methods. "method" may name several, joined by '+'
+// ("bfdsift+rld+lfd": a fused collection). A method's parameter then applies
+// to every named method it applies to ("vocabulary" to each bag-of-features
+// method), or to one when qualified by the method's name ("rld.vocabulary");
+// the canonical form of a fused collection qualifies every one. Collection
+// parameters (weights, rerank, ...) are never qualified. A parameter's default is its option struct's
 // value for the selected method (a method may set its own defaults:
 // FeatureMethodInfo::vocabulary), so the table never restates a default.
 #ifndef MESHSEEK_COMMON_PIPELINE_PIPELINE_PARAMS_H_
@@ -26,6 +34,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "common/base/json.h"
+#include "common/pipeline/collection_options.h"
 #include "common/pipeline/retrieval_pipeline.h"
 
 namespace meshseek {
@@ -45,8 +54,9 @@ struct ParamSpec {
   /// The accepted values of kChoice.
   std::vector<std::string> choices;
   /// Which methods it applies to: those listed, every bag-of-features
-  /// method (codebook and ranking parameters), or all.
-  enum class Scope { kListed, kBagOfFeatures, kAll };
+  /// method (codebook and ranking parameters), or all; or none, being a
+  /// parameter of the collection (fusion, re-ranking).
+  enum class Scope { kListed, kBagOfFeatures, kAll, kCollection };
   Scope scope = Scope::kListed;
   std::vector<FeatureMethod> methods;
 
@@ -54,6 +64,9 @@ struct ParamSpec {
   std::function<std::string(const RetrievalPipelineOptions&)> get;
   /// Sets an already parsed and range-checked value.
   std::function<void(absl::string_view, RetrievalPipelineOptions*)> set;
+  /// kCollection: the same on the collection's options.
+  std::function<std::string(const CollectionOptions&)> collection_get;
+  std::function<void(absl::string_view, CollectionOptions*)> collection_set;
 
   bool AppliesTo(FeatureMethod method) const;
   /// "int in [1, 1000000]", "one of dominant, up", ...
@@ -61,28 +74,48 @@ struct ParamSpec {
 };
 
 /// Every parameter, in the order of --help and metrics.json. "method" comes
-/// first: the others' defaults and meaning depend on it.
+/// first: the others' defaults and meaning depend on it; the collection's
+/// parameters come last.
 const std::vector<ParamSpec>& PipelineParamSpecs();
 /// nullptr for an unknown name.
 const ParamSpec* FindPipelineParam(absl::string_view name);
+/// Whether `name` is a parameter, plain or qualified by a method's name
+/// ("rld.vocabulary"); the command line takes these out of argv.
+bool IsPipelineParamName(absl::string_view name);
 
 /// (name, value) pairs in the order given.
 using ParamValues = std::vector<std::pair<std::string, std::string>>;
 
-/// Options from named values: the method first (default dld), its defaults,
-/// then every other value in order (a later value of the same name wins).
-/// InvalidArgument naming the parameter for an unknown name, a value that does
-/// not parse as its type or lies outside its range, or a parameter that does
-/// not apply to the method; then RetrievalPipelineOptions::Validate.
-absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromValues(const ParamValues& values);
+/// Options from named values: the methods first (default dld), their
+/// defaults, then every other value in order (a later value of the same name
+/// wins). InvalidArgument naming the parameter for an unknown name, a value
+/// that does not parse as its type or lies outside its range, a parameter
+/// that applies to no method named (or a qualified one to a method not
+/// named), a method named twice; then CollectionOptions::Validate.
+absl::StatusOr<CollectionOptions> CollectionOptionsFromValues(const ParamValues& values);
 
-/// Every parameter of options' method with its value, in table order: the
-/// canonical form a collection stores (its meaning does not change when a
-/// default does) and the input of PipelineOptionsFromValues.
+/// Every parameter of the collection with its value: the canonical form a
+/// collection stores (its meaning does not change when a default does) and
+/// the input of CollectionOptionsFromValues. One method: its parameters as
+/// plain names, then "rerank" (and its own parameters when enabled); several:
+/// every method's parameters qualified, then "weights" and the re-ranking.
+ParamValues CollectionValuesOf(const CollectionOptions& options);
+
+/// One method's options from values that name one method (its canonical
+/// values, or a collection's without fusion or re-ranking): what the extract
+/// and codebook services read. InvalidArgument as above, or for several
+/// methods or enabled re-ranking.
+absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromValues(const ParamValues& values);
+/// The canonical values of `options` as a collection of its own (no fusion,
+/// no re-ranking): what the coordinator gives a fused collection's member
+/// collections and the extract and codebook services.
 ParamValues PipelineValuesOf(const RetrievalPipelineOptions& options);
 
-/// The same as a JSON object of typed values, for metrics.json.
+/// One method's parameters as a JSON object of typed values, for metrics.json.
 Json PipelineParamsToJson(const RetrievalPipelineOptions& options);
+/// Adds the collection's parameters (weights of a fused collection, the
+/// re-ranking) to a JSON object.
+void AddCollectionParamsToJson(const CollectionOptions& options, Json* json);
 
 /// The parameter list for --help: name, type, the default of each method it
 /// applies to, and its doc.

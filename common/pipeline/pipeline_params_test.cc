@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 
 namespace meshseek {
@@ -38,6 +39,17 @@ TEST(PipelineParamsTest, NamesAreUniqueAndEveryDefaultLiesInItsOwnRange) {
   for (const ParamSpec& spec : PipelineParamSpecs()) {
     EXPECT_TRUE(names.insert(spec.name).second) << spec.name;
     EXPECT_FALSE(spec.doc.empty()) << spec.name;
+    if (spec.scope == ParamSpec::Scope::kCollection) {
+      for (const CollectionOptions& c :
+           {CollectionOptions(), CollectionOptions::ForMethods({FeatureMethod::kRldSift,
+                                                                FeatureMethod::kLfd})}) {
+        const std::string value = spec.collection_get(c);
+        const auto back =
+            CollectionOptionsFromValues({{"method", c.MethodName()}, {spec.name, value}});
+        EXPECT_TRUE(back.ok()) << spec.name << " = " << value << ": " << back.status();
+      }
+      continue;
+    }
     for (const FeatureMethodInfo& info : FeatureMethods()) {
       if (!spec.AppliesTo(info.method)) continue;
       const std::string value = spec.get(RetrievalPipelineOptions::ForMethod(info.method));
@@ -99,6 +111,82 @@ TEST(PipelineParamsTest, BadValuesAreRefusedNamingTheParameter) {
               HasSubstr("points does not apply to method rld"));
   // Struct validation still runs after the table's range checks.
   EXPECT_THAT(error({{"image_size", "20"}}), HasSubstr("odd"));
+}
+
+TEST(PipelineParamsTest, OneMethodRanksAloneAndSeveralAreFusedAndReranked) {
+  const CollectionOptions one;
+  EXPECT_TRUE(one.Validate().ok());
+  EXPECT_EQ(one.MethodName(), "dld");
+  EXPECT_FALSE(one.rescaled());
+  const auto fused = CollectionOptionsFromValues({{"method", "bfdsift+rld+lsf+lfd"}});
+  ASSERT_TRUE(fused.ok()) << fused.status();
+  EXPECT_EQ(fused->MethodName(), "bfdsift+rld+lsf+lfd");
+  EXPECT_EQ(fused->weights, (std::vector<double>{2, 2, 1, 1}));  // the strongest count double
+  EXPECT_EQ(fused->rerank.method, RerankOptions::Method::kKReciprocal);
+  EXPECT_EQ(fused->methods[0].kmeans.num_centroids, 40000);  // each method its own defaults
+  EXPECT_EQ(fused->methods[1].kmeans.num_centroids, 2000);
+  const RerankOptions rerank;
+  EXPECT_EQ(rerank.k1, 20);
+  EXPECT_EQ(rerank.k2, 4);
+  EXPECT_EQ(rerank.lambda, 0.1);
+  EXPECT_EQ(rerank.depth, 200);
+}
+
+TEST(PipelineParamsTest, PlainParametersSetEveryMethodTheyApplyToQualifiedOnesOne) {
+  const auto c = CollectionOptionsFromValues({{"method", "rld+dld+lfd"},
+                                              {"vocabulary", "500"},
+                                              {"rld.vocabulary", "900"},
+                                              {"image_size", "17"},
+                                              {"weights", "2,1,0.5"},
+                                              {"rerank_k1", "12"}});
+  ASSERT_TRUE(c.ok()) << c.status();
+  EXPECT_EQ(c->methods[0].kmeans.num_centroids, 900);  // the later, qualified value
+  EXPECT_EQ(c->methods[1].kmeans.num_centroids, 500);
+  EXPECT_EQ(c->methods[0].extractor.rld.depth_image.image_size, 17);
+  EXPECT_EQ(c->methods[1].extractor.dld.depth_image.image_size, 17);
+  EXPECT_EQ(c->weights, (std::vector<double>{2, 1, 0.5}));
+  EXPECT_EQ(c->rerank.k1, 12);
+  // Canonical: every method's parameters qualified, then the collection's.
+  const ParamValues values = CollectionValuesOf(*c);
+  EXPECT_EQ(values.front(), (std::pair<std::string, std::string>{"method", "rld+dld+lfd"}));
+  EXPECT_NE(std::find(values.begin(), values.end(),
+                      std::pair<std::string, std::string>{"dld.vocabulary", "500"}),
+            values.end());
+  auto back = CollectionOptionsFromValues(values);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(CollectionValuesOf(*back), values);
+  // One method: plain names, the re-ranking named (none by default).
+  const ParamValues single = CollectionValuesOf(CollectionOptions());
+  EXPECT_EQ(single.back(), (std::pair<std::string, std::string>{"rerank", "none"}));
+  EXPECT_EQ(PipelineValuesOf(RetrievalPipelineOptions()), single);
+}
+
+TEST(PipelineParamsTest, BadCollectionsAreRefusedNamingTheProblem) {
+  auto error = [](const ParamValues& values) {
+    const auto options = CollectionOptionsFromValues(values);
+    return options.ok() ? std::string("ok") : std::string(options.status().message());
+  };
+  EXPECT_THAT(error({{"method", "rld+rld"}}), HasSubstr("'rld' is named twice"));
+  EXPECT_THAT(error({{"method", "rld+sift"}}), HasSubstr("parameter method"));
+  EXPECT_THAT(error({{"method", "rld+lfd"}, {"dld.points", "5"}}),
+              HasSubstr("method dld is not in 'rld+lfd'"));
+  EXPECT_THAT(error({{"method", "rld+lfd"}, {"lfd.vocabulary", "5"}}),
+              HasSubstr("lfd.vocabulary does not apply to method lfd"));
+  EXPECT_THAT(error({{"method", "rld+lfd"}, {"points", "5"}}),
+              HasSubstr("points does not apply to method rld+lfd"));
+  EXPECT_THAT(error({{"method", "rld+lfd"}, {"weights", "1"}}), HasSubstr("weights: 1 given"));
+  EXPECT_THAT(error({{"method", "rld+lfd"}, {"weights", "0,0"}}), HasSubstr("every weight is 0"));
+  EXPECT_THAT(error({{"rerank_k2", "500"}}), HasSubstr("k2 must be in"));
+  EXPECT_THAT(error({{"method", "rld"}, {"rld.rerank", "none"}}),
+              HasSubstr("unknown parameter 'rld.rerank'"));
+  // A method's options from a collection of several are refused.
+  EXPECT_THAT(PipelineOptionsFromValues({{"method", "rld+lfd"}}).status().message(),
+              HasSubstr("one method"));
+  EXPECT_TRUE(IsPipelineParamName("rld.vocabulary"));
+  EXPECT_TRUE(IsPipelineParamName("rerank"));
+  EXPECT_FALSE(IsPipelineParamName("rld.rerank"));
+  EXPECT_FALSE(IsPipelineParamName("rld.method"));
+  EXPECT_FALSE(IsPipelineParamName("server"));
 }
 
 TEST(PipelineParamsTest, JsonHasTypedValuesOfTheMethodsParametersOnly) {

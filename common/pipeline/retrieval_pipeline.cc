@@ -65,13 +65,13 @@ absl::Status RetrievalPipelineOptions::Validate() const {
   return kl.Validate();
 }
 
-Json RetrievalPipelineOptions::ToJson() const {
+Json RetrievalPipelineOptions::ToJson(bool with_threads) const {
   Json json = PipelineParamsToJson(*this);
   if (FeatureMethodInfoOf(extractor.method).kind == DescriptorKind::kBagOfFeatures) {
     json.Set("nearest_word_search", kmeans.UsesApproximateAssignment() ? "approximate" : "exact");
     json.Set("distance", "symmetric KL divergence");
   }
-  json.Set("threads", ResolveThreadCount(num_threads));
+  if (with_threads) json.Set("threads", ResolveThreadCount(num_threads));
   return json;
 }
 
@@ -225,13 +225,14 @@ absl::StatusOr<std::vector<float>> RankGlobalCollection(const std::vector<LocalF
   return distances;
 }
 
-absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<ManifestEntry>& models,
-                                                        const RetrievalPipelineOptions& options) {
+absl::StatusOr<MethodEvaluation> EvaluateMethod(const std::vector<ManifestEntry>& models,
+                                                const RetrievalPipelineOptions& options) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   if (models.empty()) return absl::InvalidArgumentError("the collection has no models");
   const auto start = std::chrono::steady_clock::now();
-  CollectionEvaluation result;
-  result.models = models;
+  MethodEvaluation result;
+  result.method = options.extractor.method;
+  const char* name = FeatureMethodName(result.method);
 
   auto stage = std::chrono::steady_clock::now();
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<LocalFeatures> features,
@@ -242,7 +243,8 @@ absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<Manife
     if (f.size() == 0) ++result.models_without_features;
   }
   if (result.models_without_features > 0) {
-    MESHSEEK_LOG(WARNING) << result.models_without_features << " of " << models.size()
+    MESHSEEK_LOG(WARNING) << name << ": " << result.models_without_features << " of "
+                          << models.size()
                           << " models have no local features; they are ranked last for every query";
   }
 
@@ -264,49 +266,8 @@ absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<Manife
     MESHSEEK_ASSIGN_OR_RETURN(result.distances, RankCollection(histograms, options));
     result.timings.rank_seconds = SecondsSince(stage);
   }
-
-  std::vector<std::string> labels;
-  labels.reserve(models.size());
-  for (const ManifestEntry& m : models) labels.push_back(m.label);
-  MESHSEEK_ASSIGN_OR_RETURN(result.metrics,
-                            EvaluateRetrieval(labels, result.distances, options.num_threads));
   result.timings.total_seconds = SecondsSince(start);
   return result;
-}
-
-absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
-                             const RetrievalPipelineOptions& options,
-                             const std::string& out_dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(out_dir, ec);
-  if (ec) {
-    return absl::PermissionDeniedError(
-        absl::StrCat(out_dir, ": cannot create folder (", ec.message(), ")"));
-  }
-  MESHSEEK_RETURN_IF_ERROR(WriteDistanceMatrix(
-      out_dir + "/distances.bin", evaluation.distances, evaluation.models.size()));
-  Json report = MetricsToJson(evaluation.metrics);
-  report.Set("models", static_cast<int64_t>(evaluation.models.size()));
-  report.Set("parameters", options.ToJson());
-  Json& counts = report.Set("local_features", Json::MakeObject());
-  const auto& per_model = evaluation.features_per_model;
-  if (!per_model.empty()) {
-    std::vector<std::size_t> sorted = per_model;
-    std::sort(sorted.begin(), sorted.end());
-    counts.Set("total",
-               static_cast<int64_t>(std::accumulate(sorted.begin(), sorted.end(), std::size_t{0})));
-    counts.Set("min_per_model", static_cast<int64_t>(sorted.front()));
-    counts.Set("median_per_model", static_cast<int64_t>(sorted[sorted.size() / 2]));
-    counts.Set("max_per_model", static_cast<int64_t>(sorted.back()));
-    counts.Set("models_without_features", static_cast<int64_t>(evaluation.models_without_features));
-  }
-  Json& timings = report.Set("timings_seconds", Json::MakeObject());
-  timings.Set("extract", evaluation.timings.extract_seconds);
-  timings.Set("codebook", evaluation.timings.codebook_seconds);
-  timings.Set("encode", evaluation.timings.encode_seconds);
-  timings.Set("rank", evaluation.timings.rank_seconds);
-  timings.Set("total", evaluation.timings.total_seconds);
-  return WriteStringToFile(out_dir + "/metrics.json", report.Dump());
 }
 
 }  // namespace meshseek

@@ -5,8 +5,9 @@
 // own local features.
 //
 // Each stage is a function of its own so that the distributed services run the
-// same code stage by stage; EvaluateCollection chains them for the CLI's
-// `eval` and the end-to-end tests.
+// same code stage by stage; EvaluateMethod chains them for one method, and
+// EvaluateCollection (collection_evaluation.h) combines the methods of a
+// collection for the CLI's `eval` and the end-to-end tests.
 #ifndef MESHSEEK_COMMON_PIPELINE_RETRIEVAL_PIPELINE_H_
 #define MESHSEEK_COMMON_PIPELINE_RETRIEVAL_PIPELINE_H_
 
@@ -20,7 +21,6 @@
 #include "common/bof/kl_divergence.h"
 #include "common/bof/kmeans.h"
 #include "common/eval/manifest.h"
-#include "common/eval/retrieval_metrics.h"
 #include "common/features/local_feature_extractor.h"
 
 namespace meshseek {
@@ -50,7 +50,7 @@ struct RetrievalPipelineOptions {
   absl::Status Validate() const;
   /// Every parameter that affects the result (pipeline_params.h) and the
   /// threads, for metrics.json.
-  Json ToJson() const;
+  Json ToJson(bool with_threads = true) const;
 };
 
 // Reads and extracts every model, in parallel across models. The first
@@ -94,27 +94,24 @@ struct StageTimings {
   double total_seconds = 0;
 };
 
-struct CollectionEvaluation {
-  std::vector<ManifestEntry> models;  // input order = matrix order
-  std::vector<std::size_t> features_per_model;
+// One method's all-pairs distances over a collection, with what it took.
+struct MethodEvaluation {
+  FeatureMethod method = FeatureMethod::kDldSift;
+  std::vector<std::size_t> features_per_model;  // input order
   std::size_t models_without_features = 0;
-  std::size_t codebook_size = 0;
-  std::vector<float> distances;  // N x N row-major, entry i*N+j = D(model i, model j)
-  RetrievalMetrics metrics;
+  std::size_t codebook_size = 0;  // 0 for a global method
+  /// N x N row-major, entry i*N+j = D(model i, model j), the method's own
+  /// distance (empty when the services computed the collection's ranking).
+  std::vector<float> distances;
+  /// What the distances are divided by in a rescaled collection (fusion.h).
+  double scale = 1.0;
   StageTimings timings;
 };
 
-// Runs every stage on a labelled collection and evaluates the ranking; a
-// global method (DescriptorKind::kGlobal) skips the codebook and encoding.
-absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<ManifestEntry>& models,
-                                                        const RetrievalPipelineOptions& options);
-
-// Writes DIR/distances.bin (PSB float32 matrix, manifest order) and
-// DIR/metrics.json (every metric, micro and macro, per class, the parameters,
-// feature counts and stage timings). Creates DIR if needed.
-absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
-                             const RetrievalPipelineOptions& options,
-                             const std::string& out_dir);
+// Extracts, learns the codebook, encodes and ranks every pair (a global
+// method skips the codebook and encoding) with one method.
+absl::StatusOr<MethodEvaluation> EvaluateMethod(const std::vector<ManifestEntry>& models,
+                                                const RetrievalPipelineOptions& options);
 
 }  // namespace meshseek
 

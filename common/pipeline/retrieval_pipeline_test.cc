@@ -83,7 +83,7 @@ TEST(RetrievalPipelineTest, HistogramDistancesAreInvariantToSimilarityTransforms
 }
 
 TEST(RetrievalPipelineTest, EmptyCollectionIsAnError) {
-  auto result = EvaluateCollection({}, RetrievalPipelineOptions());
+  auto result = EvaluateMethod({}, RetrievalPipelineOptions());
   ASSERT_FALSE(result.ok());
   EXPECT_NE(result.status().message().find("no models"), absl::string_view::npos);
 }

@@ -287,24 +287,48 @@ absl::StatusOr<ParamValues> LegacyValues(const v1::PipelineParams& p) {
 
 }  // namespace
 
-absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromParams(const v1::PipelineParams& p) {
+namespace {
+
+absl::StatusOr<ParamValues> AllValues(const v1::PipelineParams& p) {
   MESHSEEK_ASSIGN_OR_RETURN(ParamValues values, LegacyValues(p));
   for (const v1::ParamValue& value : p.values()) values.emplace_back(value.name(), value.value());
-  absl::StatusOr<RetrievalPipelineOptions> options = PipelineOptionsFromValues(values);
-  if (!options.ok()) {
-    return absl::Status(options.status().code(),
-                        absl::StrCat("params: ", options.status().message()));
-  }
-  return options;
+  return values;
 }
 
-void PipelineParamsToProto(const RetrievalPipelineOptions& options, v1::PipelineParams* out) {
+template <typename T>
+absl::StatusOr<T> Prefixed(absl::StatusOr<T> options) {
+  if (options.ok()) return options;
+  return absl::Status(options.status().code(),
+                      absl::StrCat("params: ", options.status().message()));
+}
+
+void ValuesToProto(const ParamValues& values, v1::PipelineParams* out) {
   out->Clear();
-  for (const auto& [name, value] : PipelineValuesOf(options)) {
+  for (const auto& [name, value] : values) {
     v1::ParamValue* v = out->add_values();
     v->set_name(name);
     v->set_value(value);
   }
+}
+
+}  // namespace
+
+absl::StatusOr<CollectionOptions> CollectionOptionsFromParams(const v1::PipelineParams& p) {
+  MESHSEEK_ASSIGN_OR_RETURN(const ParamValues values, AllValues(p));
+  return Prefixed(CollectionOptionsFromValues(values));
+}
+
+void CollectionParamsToProto(const CollectionOptions& options, v1::PipelineParams* out) {
+  ValuesToProto(CollectionValuesOf(options), out);
+}
+
+absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromParams(const v1::PipelineParams& p) {
+  MESHSEEK_ASSIGN_OR_RETURN(const ParamValues values, AllValues(p));
+  return Prefixed(PipelineOptionsFromValues(values));
+}
+
+void PipelineParamsToProto(const RetrievalPipelineOptions& options, v1::PipelineParams* out) {
+  ValuesToProto(PipelineValuesOf(options), out);
 }
 
 }  // namespace meshseek::rpc

@@ -13,6 +13,7 @@
 #include "common/geometry/mesh.h"
 #include "common/geometry/mesh_io.h"
 #include "common/geometry/point_graph.h"
+#include "common/pipeline/collection_options.h"
 #include "common/pipeline/retrieval_pipeline.h"
 #include "common/search/sparse_histogram.h"
 #include "meshseek/v1/types.pb.h"
@@ -44,13 +45,19 @@ void HistogramToProto(const std::vector<float>& dense,
                       std::size_t vocabulary_size,
                       v1::SparseHistogram* out);
 
-// Pipeline options from parameters (the legacy fields, then the named values;
-// common/pipeline/pipeline_params.h): parameters not given take the method's
-// defaults. Validated; InvalidArgument names the parameter.
+// A collection's options from parameters (the legacy fields, then the named
+// values; common/pipeline/pipeline_params.h): parameters not given take the
+// methods' defaults. Validated; InvalidArgument names the parameter.
+absl::StatusOr<CollectionOptions> CollectionOptionsFromParams(const v1::PipelineParams& params);
+// The canonical parameters of `options` (CollectionValuesOf): every
+// parameter by name, nothing in the legacy fields. CollectionOptionsFromParams
+// reads back the same options.
+void CollectionParamsToProto(const CollectionOptions& options, v1::PipelineParams* out);
+
+// One method's options: parameters that name one method without re-ranking
+// (what extract and codebook requests carry); InvalidArgument otherwise.
 absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromParams(const v1::PipelineParams& params);
-// The canonical parameters of `options`: every parameter of its method by
-// name, nothing in the legacy fields. PipelineOptionsFromParams reads back
-// the same options.
+// The canonical parameters of one method as a collection of its own.
 void PipelineParamsToProto(const RetrievalPipelineOptions& options, v1::PipelineParams* out);
 
 }  // namespace meshseek::rpc

@@ -1,0 +1,244 @@
+// Fusion and re-ranking choices on a labelled collection, from the distance
+// matrices each method's `meshseek eval` wrote (bench/results/fusion.txt):
+//
+//   fusion_sweep --manifest SET/manifest.csv \
+//     --matrices bfdsift=out/bf/distances.bin,rld=out/rld/distances.bin,... \
+//     --combos bfdsift+rld,bfdsift+rld+lfd [--weights "1,1;2,1"] \
+//     [--normalisations scale,query_mean,query_z,query_knn] \
+//     [--k1 10,20 --k2 1,4 --lambda 0.1,0.3 --depth 100] [--csv OUT] [--tag TEXT]
+//
+// Every combination of the lists is one row: the methods, their weights (a
+// weight list per combination size; default the methods' own), the normalisation, and
+// the re-ranking (rerank none first, then every k1, k2, lambda, depth).
+// "scale" is what meshseek ships (CombineMethodDistances, each method divided
+// by its mean over the collection); the query_* normalisations divide each
+// row by its own mean, standardise it, or divide by the mean of its 10
+// nearest, for comparison. Metrics as metrics.json computes them.
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
+#include "common/eval/distance_matrix.h"
+#include "common/eval/manifest.h"
+#include "common/eval/retrieval_metrics.h"
+#include "common/pipeline/collection_evaluation.h"
+#include "common/search/fusion.h"
+#include "common/search/neighbor_graph.h"
+#include "common/search/rerank.h"
+
+ABSL_FLAG(std::string, manifest, "", "CSV manifest id,class,path (the matrices' order)");
+ABSL_FLAG(std::string, matrices, "", "method=path of its distances.bin, comma-separated");
+ABSL_FLAG(std::string, combos, "", "methods joined by +, comma-separated (default: all given)");
+ABSL_FLAG(std::string, weights, "", "weight lists separated by ';' (default: the methods' own)");
+ABSL_FLAG(std::string, normalisations, "scale", "scale,query_mean,query_z,query_knn");
+ABSL_FLAG(std::string, k1, "20", "re-ranking k1 values");
+ABSL_FLAG(std::string, k2, "4", "re-ranking k2 values");
+ABSL_FLAG(std::string, lambda, "0.1", "re-ranking lambda values");
+ABSL_FLAG(std::string, depth, "200", "re-ranking depth values");
+ABSL_FLAG(bool, rerank_only, false, "skip the rows without re-ranking");
+ABSL_FLAG(std::string, csv, "", "append rows to this CSV file");
+ABSL_FLAG(std::string, tag, "", "free text copied into the rows");
+ABSL_FLAG(int, threads, 0, "threads (0: all cores)");
+
+namespace {
+
+using namespace meshseek;
+
+std::vector<double> Numbers(absl::string_view text) {
+  std::vector<double> values;
+  for (absl::string_view part : absl::StrSplit(text, ',', absl::SkipEmpty())) {
+    double v;
+    if (!absl::SimpleAtod(part, &v)) {
+      std::fprintf(stderr, "bad number '%s'\n", std::string(part).c_str());
+      std::exit(2);
+    }
+    values.push_back(v);
+  }
+  return values;
+}
+
+// Each row divided by (or standardised with) its own statistics over the
+// other models, then symmetrised.
+std::vector<float> QueryNormalised(const std::vector<float>& d, std::size_t n,
+                                   const std::string& how) {
+  std::vector<float> out(n * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<double> others;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j != i && std::isfinite(d[i * n + j])) others.push_back(d[i * n + j]);
+    }
+    double mean = 0, var = 0;
+    for (double x : others) mean += x;
+    mean /= std::max<std::size_t>(others.size(), 1);
+    for (double x : others) var += (x - mean) * (x - mean);
+    const double sd = std::sqrt(var / std::max<std::size_t>(others.size(), 1));
+    double knn = mean;
+    if (how == "query_knn") {
+      std::sort(others.begin(), others.end());
+      knn = 0;
+      const std::size_t k = std::min<std::size_t>(10, others.size());
+      for (std::size_t r = 0; r < k; ++r) knn += others[r];
+      knn /= std::max<std::size_t>(k, 1);
+    }
+    for (std::size_t j = 0; j < n; ++j) {
+      const double x = d[i * n + j];
+      out[i * n + j] = static_cast<float>(how == "query_z"     ? (x - mean) / sd
+                                          : how == "query_knn" ? x / knn
+                                                               : x / mean);
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const float s = 0.5f * (out[i * n + j] + out[j * n + i]);
+      out[i * n + j] = out[j * n + i] = s;
+    }
+    out[i * n + i] = how == "query_z" ? -1e30f : 0.0f;
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  absl::ParseCommandLine(argc, argv);
+  auto models = ReadManifest(absl::GetFlag(FLAGS_manifest));
+  if (!models.ok()) {
+    std::fprintf(stderr, "%s\n", models.status().ToString().c_str());
+    return 1;
+  }
+  const std::size_t n = models->size();
+  std::vector<std::string> labels;
+  for (const ManifestEntry& m : *models) labels.push_back(m.label);
+
+  std::map<std::string, std::vector<float>> matrices;
+  std::vector<std::string> given;
+  for (absl::string_view item : absl::StrSplit(absl::GetFlag(FLAGS_matrices), ',', absl::SkipEmpty())) {
+    std::pair<std::string, std::string> kv = absl::StrSplit(item, absl::MaxSplits('=', 1));
+    auto matrix = ReadDistanceMatrix(kv.second, n);
+    if (!matrix.ok()) {
+      std::fprintf(stderr, "%s\n", matrix.status().ToString().c_str());
+      return 1;
+    }
+    matrices[kv.first] = *std::move(matrix);
+    given.push_back(kv.first);
+  }
+  std::vector<std::string> combos =
+      absl::StrSplit(absl::GetFlag(FLAGS_combos), ',', absl::SkipEmpty());
+  if (combos.empty()) combos.push_back(absl::StrJoin(given, "+"));
+  std::vector<std::string> weight_lists =
+      absl::StrSplit(absl::GetFlag(FLAGS_weights), ';', absl::SkipEmpty());
+
+  std::printf("tag,methods,weights,normalisation,rerank,k1,k2,lambda,depth,NN,FT,ST,E,DCG,"
+              "FT_macro,seconds\n");
+  for (const std::string& combo : combos) {
+    const std::vector<std::string> names = absl::StrSplit(combo, '+');
+    std::vector<FeatureMethod> methods;
+    std::vector<absl::Span<const float>> parts;
+    for (const std::string& name : names) {
+      auto m = ParseFeatureMethod(name);
+      if (!m.ok() || !matrices.count(name)) {
+        std::fprintf(stderr, "no matrix for method '%s'\n", name.c_str());
+        return 2;
+      }
+      methods.push_back(*m);
+      parts.push_back(matrices[name]);
+    }
+    std::vector<std::vector<double>> weightings;
+    for (const std::string& w : weight_lists) {
+      if (Numbers(w).size() == names.size()) weightings.push_back(Numbers(w));
+    }
+    if (weightings.empty()) weightings.push_back(CollectionOptions::ForMethods(methods).weights);
+    for (const std::vector<double>& weights : weightings) {
+      for (absl::string_view how :
+           absl::StrSplit(absl::GetFlag(FLAGS_normalisations), ',', absl::SkipEmpty())) {
+        // The re-ranking settings: none first, then every combination.
+        std::vector<RerankOptions> reranks;
+        if (!absl::GetFlag(FLAGS_rerank_only)) {
+          reranks.emplace_back();
+          reranks.back().method = RerankOptions::Method::kNone;
+        }
+        for (double k1 : Numbers(absl::GetFlag(FLAGS_k1))) {
+          for (double k2 : Numbers(absl::GetFlag(FLAGS_k2))) {
+            for (double lambda : Numbers(absl::GetFlag(FLAGS_lambda))) {
+              for (double depth : Numbers(absl::GetFlag(FLAGS_depth))) {
+                RerankOptions r;
+                r.k1 = static_cast<int>(k1);
+                r.k2 = static_cast<int>(k2);
+                r.lambda = lambda;
+                r.depth = static_cast<int>(depth);
+                reranks.push_back(r);
+              }
+            }
+          }
+        }
+        for (const RerankOptions& rerank : reranks) {
+          const auto start = std::chrono::steady_clock::now();
+          CollectionOptions options = CollectionOptions::ForMethods(methods);
+          options.SetRunOptions(absl::GetFlag(FLAGS_threads), false);
+          options.weights = weights;
+          options.rerank = rerank;
+          absl::StatusOr<std::vector<float>> ranked;
+          std::vector<double> scales;
+          if (how == "scale") {
+            // One method without re-ranking is its own distance: rescaling
+            // changes no ranking, so the shipped path serves every row.
+            ranked = CombineMethodDistances(parts, n, options, &scales);
+          } else {
+            // Per-query normalisations: each method's rows normalised, then
+            // fused with the weights (scales 1) and re-ranked the same way.
+            std::vector<std::vector<float>> normalised;
+            for (const absl::Span<const float>& p : parts) {
+              normalised.push_back(
+                  QueryNormalised(std::vector<float>(p.begin(), p.end()), n, std::string(how)));
+            }
+            std::vector<absl::Span<const float>> spans(normalised.begin(), normalised.end());
+            std::vector<float> fused(n * n);
+            const std::vector<double> ones(names.size(), 1.0);
+            auto factors = FusionFactors(weights, ones);
+            for (std::size_t i = 0; i < n; ++i) {
+              std::vector<absl::Span<const float>> rows;
+              for (const auto& s : spans) rows.push_back(s.subspan(i * n, n));
+              FuseRows(rows, *factors, absl::MakeSpan(fused).subspan(i * n, n));
+            }
+            ranked = fused;
+            if (rerank.enabled() && how != "query_z") {
+              auto graph = NeighborGraph::FromMatrix(fused, n, rerank.graph_k());
+              ranked = RerankMatrix(*graph, fused, rerank);
+            }
+          }
+          if (!ranked.ok()) {
+            std::fprintf(stderr, "%s\n", ranked.status().ToString().c_str());
+            return 1;
+          }
+          auto metrics = EvaluateRetrieval(labels, *ranked, absl::GetFlag(FLAGS_threads));
+          const double seconds =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+          std::vector<std::string> w;
+          for (double x : weights) w.push_back(absl::StrFormat("%g", x));
+          const std::string row = absl::StrFormat(
+              "%s,%s,%s,%s,%s,%d,%d,%g,%d,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f",
+              absl::GetFlag(FLAGS_tag), combo, absl::StrJoin(w, ":"), how,
+              rerank.enabled() ? "kreciprocal" : "none", rerank.k1, rerank.k2, rerank.lambda,
+              rerank.depth, 100 * metrics->micro.nn, 100 * metrics->micro.rp_excl,
+              100 * metrics->micro.second_tier, 100 * metrics->micro.e_measure,
+              100 * metrics->micro.dcg, 100 * metrics->macro.rp_excl, seconds);
+          std::printf("%s\n", row.c_str());
+          std::fflush(stdout);
+          if (!absl::GetFlag(FLAGS_csv).empty()) {
+            std::ofstream(absl::GetFlag(FLAGS_csv), std::ios::app) << row << "\n";
+          }
+        }
+      }
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,75 @@
+// What a collection is: one or more feature methods, each with its own
+// pipeline (RetrievalPipelineOptions), and how their distances become one
+// ranking (DESIGN.md 2.7, README "Beyond the paper").
+//
+//   one method, no re-ranking   the method's own distance, as the paper ranks
+//                               (symmetric KL of BoF histograms, LFD's own);
+//   several methods ("a+b")     each method's distances divided by their mean
+//                               over the collection and averaged with the
+//                               weights (common/search/fusion.h);
+//   re-ranking                  k-reciprocal re-ranking over the collection's
+//                               neighbour graph (common/search/rerank.h), on
+//                               the fused (or one method's scaled) distances.
+//
+// Defaults, measured on the development sets (bench/results/fusion.txt): a
+// collection of one method ranks as the paper does, with no re-ranking; a
+// collection of several re-ranks by default, each method weighted by its
+// FeatureMethodInfo::fusion_weight.
+#ifndef MESHSEEK_COMMON_PIPELINE_COLLECTION_OPTIONS_H_
+#define MESHSEEK_COMMON_PIPELINE_COLLECTION_OPTIONS_H_
+
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "common/base/json.h"
+#include "common/pipeline/retrieval_pipeline.h"
+#include "common/search/rerank.h"
+
+namespace meshseek {
+
+struct CollectionOptions {
+  /// Most methods one collection may fuse.
+  static constexpr std::size_t kMaxMethods = 8;
+
+  /// DLD-SIFT alone.
+  CollectionOptions();
+  /// Each method with its defaults, in this order, the fusion and re-ranking
+  /// defaults for that many methods.
+  static CollectionOptions ForMethods(const std::vector<FeatureMethod>& methods);
+  /// One method with these options, no re-ranking.
+  static CollectionOptions Of(const RetrievalPipelineOptions& method);
+
+  /// One pipeline per method, in the order named: distinct methods.
+  std::vector<RetrievalPipelineOptions> methods;
+  /// Fusion weights, one per method (>= 0, not all 0); default: each
+  /// method's fusion_weight.
+  std::vector<double> weights;
+  /// Re-ranking over the collection's neighbour graph.
+  RerankOptions rerank;
+
+  bool fused() const { return methods.size() > 1; }
+  /// Distances are rescaled (each method's by its collection mean): when
+  /// fused or re-ranked. Otherwise a collection ranks by its method's own.
+  bool rescaled() const { return fused() || rerank.enabled(); }
+  /// "dld", or the methods joined by '+' ("bfdsift+rld").
+  std::string MethodName() const;
+  /// Threads and progress bars of every method's pipeline.
+  void SetRunOptions(int num_threads, bool show_progress);
+  int num_threads() const { return methods.empty() ? 0 : methods.front().num_threads; }
+  bool show_progress() const { return !methods.empty() && methods.front().show_progress; }
+
+  /// Each method's Validate, then: 1 to kMaxMethods distinct methods, one
+  /// weight per method, and the re-ranking options; InvalidArgument naming
+  /// what is wrong.
+  absl::Status Validate() const;
+  /// Every parameter (pipeline_params.h) and the threads, for metrics.json:
+  /// a method's block as RetrievalPipelineOptions::ToJson, a fused
+  /// collection's blocks under each method's name beside the weights and the
+  /// re-ranking.
+  Json ToJson() const;
+};
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_COMMON_PIPELINE_COLLECTION_OPTIONS_H_

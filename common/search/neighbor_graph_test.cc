@@ -1,0 +1,84 @@
+#include "common/search/neighbor_graph.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <random>
+
+namespace meshseek {
+namespace {
+
+// Points on a line: distance |x_i - x_j|.
+std::vector<float> LineMatrix(const std::vector<float>& x) {
+  const std::size_t n = x.size();
+  std::vector<float> d(n * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j < n; ++j) d[i * n + j] = std::abs(x[i] - x[j]);
+  }
+  return d;
+}
+
+TEST(NeighborGraphTest, ListsStartWithTheModelThenNearestTiesByNode) {
+  // Models 1 and 2 are both 1 from model 0; model 3 coincides with 0.
+  const std::vector<float> x = {0, 1, -1, 0, 5};
+  auto graph = NeighborGraph::FromMatrix(LineMatrix(x), x.size(), 3, 2);
+  ASSERT_TRUE(graph.ok()) << graph.status();
+  EXPECT_EQ(graph->k(), 3);
+  const auto list0 = graph->Of(0);
+  EXPECT_EQ(list0[0], (GraphNeighbor{0, 0.0f}));
+  EXPECT_EQ(list0[1], (GraphNeighbor{3, 0.0f}));  // the twin at 0, after itself
+  EXPECT_EQ(list0[2], (GraphNeighbor{1, 1.0f}));  // 1 before 2 at the same distance
+  const auto list3 = graph->Of(3);
+  EXPECT_EQ(list3[0].node, 3u);
+  EXPECT_EQ(list3[1].node, 0u);
+  EXPECT_EQ(graph->Of(4)[1], (GraphNeighbor{1, 4.0f}));
+}
+
+TEST(NeighborGraphTest, ShortCollectionsKeepEveryModelAndInfinityRanksLast) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<float> d = {0, inf, 2,  //
+                                inf, 0, inf,
+                                2, inf, 0};
+  auto graph = NeighborGraph::FromMatrix(d, 3, 10);
+  ASSERT_TRUE(graph.ok());
+  EXPECT_EQ(graph->k(), 3);
+  EXPECT_EQ(graph->Of(0)[1].node, 2u);
+  EXPECT_EQ(graph->Of(0)[2], (GraphNeighbor{1, inf}));
+}
+
+TEST(NeighborGraphTest, SerializedGraphReadsBackAndDamageIsNamed) {
+  std::mt19937 rng(7);
+  std::vector<float> x(40);
+  for (float& v : x) v = static_cast<float>(rng() % 1000) / 10.0f;
+  auto graph = NeighborGraph::FromMatrix(LineMatrix(x), x.size(), 6);
+  ASSERT_TRUE(graph.ok());
+  const std::string bytes = graph->Serialize();
+  auto back = NeighborGraph::Parse(bytes);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_TRUE(*back == *graph);
+
+  for (const std::size_t cut : {std::size_t{0}, std::size_t{10}, bytes.size() - 1}) {
+    EXPECT_EQ(NeighborGraph::Parse(bytes.substr(0, cut)).status().code(),
+              absl::StatusCode::kDataLoss);
+  }
+  std::string flipped = bytes;
+  flipped[30] ^= 1;
+  EXPECT_NE(NeighborGraph::Parse(flipped).status().message().find("checksum"), std::string::npos);
+  std::string lying = bytes;
+  lying[8] = 41;  // n = 41 for 40 lists
+  EXPECT_NE(NeighborGraph::Parse(lying).status().message().find("bytes for 41 lists"),
+            std::string::npos);
+}
+
+TEST(NeighborGraphTest, BadInputIsRefused) {
+  EXPECT_FALSE(NeighborGraph::Create(10, 0).ok());
+  EXPECT_FALSE(NeighborGraph::Create(10, NeighborGraph::kMaxK + 1).ok());
+  EXPECT_FALSE(NeighborGraph::FromMatrix(std::vector<float>(5), 2, 2).ok());
+  EXPECT_FALSE(NeighborGraph::FromMatrix({0, std::nanf(""), 1, 0}, 2, 2).ok());
+  auto empty = NeighborGraph::Create(0, 5);
+  ASSERT_TRUE(empty.ok());
+  EXPECT_TRUE(NeighborGraph::Parse(empty->Serialize()).ok());
+}
+
+}  // namespace
+}  // namespace meshseek
