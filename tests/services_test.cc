@@ -642,6 +642,89 @@ TEST_F(ServicesTest, AGlobalDescriptorCollectionSurvivesKillsAndEqualsInProcess)
   }());
 }
 
+// A fused, re-ranked collection (LSF + LFD, small settings): each model
+// stored in both members, each extracted with its method, the build builds
+// both and the ranking state; over two shards, with the coordinator killed
+// during the build, Evaluate gives the in-process matrix bit for bit.
+TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
+  v1::PipelineParams params;
+  for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
+           {"method", "lsf+lfd"}, {"points", "128"}, {"vocabulary", "64"}, {"view_size", "64"},
+           {"rerank_k1", "5"}, {"rerank_k2", "2"}, {"rerank_depth", "20"}}) {
+    v1::ParamValue* v = params.add_values();
+    v->set_name(name);
+    v->set_value(value);
+  }
+  auto options = rpc::CollectionOptionsFromParams(params);
+  ASSERT_TRUE(options.ok()) << options.status();
+  ASSERT_TRUE(options->fused() && options->rerank.enabled());
+  const std::size_t n = models_->size() / 3;
+  const std::vector<ManifestEntry> models(models_->begin(), models_->begin() + n);
+  CollectionOptions in_process = *options;
+  in_process.SetRunOptions(2, false);
+  auto reference = EvaluateCollection(models, in_process);
+  ASSERT_TRUE(reference.ok()) << reference.status();
+
+  Stack stack(*dir_ + "/fused", 1, 512, /*index_shards=*/2);
+  ASSERT_TRUE(stack.WaitServing());
+  auto stub = stack.Coordinator();
+  ASSERT_TRUE(CreateCollection(stub.get(), "fused", params).ok());
+  std::set<std::string> jobs;
+  ASSERT_EQ(Ingest(stub.get(), "fused", 0, n, &jobs), n);
+  for (const std::string& job : jobs) {
+    EXPECT_EQ(WaitJob(stub.get(), job).state(), v1::JOB_STATE_SUCCEEDED);
+  }
+  // The members are the coordinator's: clients use the fused collection.
+  {
+    grpc::ClientContext context;
+    v1::BuildRequest request;
+    request.set_collection("fused~lsf");
+    v1::JobStatus status;
+    EXPECT_EQ(stub->Build(&context, request, &status).error_code(),
+              grpc::StatusCode::INVALID_ARGUMENT);
+  }
+  const std::string build_id = Build(stub.get(), "fused");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  stack.coordinator().Kill(SIGKILL);  // mid-build: resumed at the restart
+  stack.coordinator().Start();
+  ASSERT_TRUE(stack.WaitServing());
+  const v1::JobStatus build = WaitJob(stub.get(), build_id);
+  ASSERT_EQ(build.state(), v1::JOB_STATE_SUCCEEDED) << build.DebugString();
+  EXPECT_EQ(Evaluate(stub.get(), "fused", n), reference->distances);
+
+  // Restored after kill -9 of everything that holds state.
+  stack.index(0).Kill(SIGKILL);
+  stack.index(1).Kill(SIGKILL);
+  stack.coordinator().Kill(SIGKILL);
+  stack.index(0).Start();
+  stack.index(1).Start();
+  stack.coordinator().Start();
+  ASSERT_TRUE(stack.WaitServing());
+  EXPECT_EQ(Evaluate(stub.get(), "fused", n), reference->distances);
+
+  // A model queried joins the graph beside its stored copy: that copy first.
+  v1::QueryResponse response;
+  grpc::Status status = Query(stub.get(), "fused", 4, 3, absl::Seconds(60), &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(response.results_size(), 3);
+  EXPECT_EQ(response.results(0).model_id(), (*models_)[4].id);
+  EXPECT_GT(response.query_features(), 1u);  // LSF's features and LFD's one descriptor
+
+  // Removed from both members: it ranks nowhere until the next build.
+  {
+    grpc::ClientContext context;
+    v1::RemoveModelFromCollectionRequest remove;
+    remove.set_collection("fused");
+    remove.set_model_id((*models_)[4].id);
+    v1::RemoveModelFromCollectionResponse removed;
+    ASSERT_TRUE(stub->RemoveModel(&context, remove, &removed).ok());
+    EXPECT_TRUE(removed.removed());
+  }
+  status = Query(stub.get(), "fused", 4, 3, absl::Seconds(60), &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  for (const v1::ScoredModel& m : response.results()) EXPECT_NE(m.model_id(), (*models_)[4].id);
+}
+
 TEST_F(ServicesTest, TwoIndexShardsGiveTheResultsOfOneAndNeverAPartialAnswer) {
   Stack stack(*dir_ + "/shards", 1, 512, /*index_shards=*/2);
   ASSERT_TRUE(stack.WaitServing());

@@ -139,6 +139,16 @@ absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
   }
   MESHSEEK_RETURN_IF_ERROR(WriteDistanceMatrix(
       out_dir + "/distances.bin", evaluation.distances, evaluation.models.size()));
+  if (evaluation.methods.size() > 1) {
+    // Each method's own matrix beside the fused one: the ablation's input
+    // (bench/fusion_sweep) without extracting again.
+    for (const MethodEvaluation& m : evaluation.methods) {
+      if (m.distances.empty()) continue;
+      MESHSEEK_RETURN_IF_ERROR(WriteDistanceMatrix(
+          absl::StrCat(out_dir, "/distances.", FeatureMethodName(m.method), ".bin"), m.distances,
+          evaluation.models.size()));
+    }
+  }
   Json report = MetricsToJson(evaluation.metrics);
   report.Set("models", static_cast<int64_t>(evaluation.models.size()));
   report.Set("parameters", options.ToJson());

@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <random>
 
+#include "absl/strings/str_cat.h"
 #include "common/base/file_io.h"
+#include "common/eval/distance_matrix.h"
 #include "common/pipeline/pipeline_params.h"
 #include "common/search/fusion.h"
 #include "common/synth/synthetic_benchmark.h"
@@ -117,6 +119,14 @@ TEST(EvaluateCollectionTest, AFusedCollectionCombinesItsMethodsEvaluatedAlone) {
   for (const char* key : {"\"method\": \"lsf+lfd\"", "\"lsf\": {", "\"weights\": [", "\"rerank\": \"kreciprocal\"",
                           "\"distance_scales\"", "\"rerank_k1\": 4"}) {
     EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
+  }
+  // Each method's own matrix beside the fused one, for the ablation.
+  for (std::size_t m = 0; m < 2; ++m) {
+    const std::string method(FeatureMethodName(fused->methods[m].method));
+    auto matrix = ReadDistanceMatrix(absl::StrCat(dir, "/eval/distances.", method, ".bin"),
+                                     models->size());
+    ASSERT_TRUE(matrix.ok()) << method << ": " << matrix.status();
+    EXPECT_EQ(*matrix, fused->methods[m].distances) << method;
   }
 }
 

@@ -1,11 +1,14 @@
 #include "services/coordinator/build_runner.h"
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "common/base/logging.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
 #include "common/rpc/status.h"
+#include "services/coordinator/ranking.h"
 
 namespace meshseek {
 namespace {
@@ -43,7 +46,12 @@ void BuildRunner::Done(const std::string& collection) {
 }
 
 absl::StatusOr<std::string> BuildRunner::Start(const std::string& collection) {
-  MESHSEEK_RETURN_IF_ERROR(LoadCollection(store_, collection).status());
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionPlan plan, LoadCollectionPlan(store_, collection));
+  if (plan.member) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "collection '", collection, "' is a member of '",
+        collection.substr(0, collection.find('~')), "': build that one"));
+  }
   {
     absl::MutexLock lock(&mutex_);
     if (!building_.insert(collection).second) {
@@ -51,7 +59,7 @@ absl::StatusOr<std::string> BuildRunner::Start(const std::string& collection) {
           absl::StrCat("collection '", collection, "' is already being built"));
     }
   }
-  absl::StatusOr<ModelCounts> counts = store_->CountModels(collection, "");
+  absl::StatusOr<ModelCounts> counts = store_->CountModels(plan.PartNames(), "");
   absl::Status ready = counts.status();
   if (counts.ok() && (counts->pending > 0 || counts->extracted < 2)) {
     ready = absl::FailedPreconditionError(absl::StrCat(
@@ -59,8 +67,10 @@ absl::StatusOr<std::string> BuildRunner::Start(const std::string& collection) {
         " waiting for extraction, ", counts->extracted, " extracted and ", counts->failed,
         " failed; a build needs none waiting and at least 2 extracted"));
   }
+  // Work items: each model in each part.
   absl::StatusOr<std::string> job =
-      ready.ok() ? store_->NewJob("build", collection, counts->extracted) : ready;
+      ready.ok() ? store_->NewJob("build", collection, counts->extracted * plan.parts.size())
+                 : ready;
   if (!job.ok()) {
     Done(collection);
     return job.status();
@@ -134,64 +144,120 @@ absl::Status BuildRunner::Train(const std::string& codebook_id,
       workers_->retry(), stop_);
 }
 
-void BuildRunner::Run(const std::string& job_id, const std::string& collection) {
-  const std::string codebook_id = absl::StrCat(collection, "@", job_id);
-  auto fail = [&](const absl::Status& status) {
-    MESHSEEK_LOG(ERROR) << "coordinator: " << job_id << " failed: " << status;
-    (void)store_->FinishJob(job_id, v1::JOB_STATE_FAILED, status.ToString());
-    Done(collection);
-  };
-  absl::StatusOr<CollectionInfo> info = LoadCollection(store_, collection);
-  if (!info.ok()) return fail(info.status());
+absl::Status BuildRunner::BuildPart(const std::string& job_id,
+                                    const CollectionInfo& part,
+                                    const std::optional<std::set<std::string>>& eligible) {
+  const std::string codebook_id = absl::StrCat(part.name, "@", job_id);
   const absl::Time start = absl::Now();
-  absl::StatusOr<std::vector<ExtractedModel>> members = store_->ExtractedModels(collection);
-  if (!members.ok()) return fail(members.status());
+  MESHSEEK_ASSIGN_OR_RETURN(std::vector<ExtractedModel> members, store_->ExtractedModels(part.name));
+  if (eligible.has_value()) {
+    // A fused collection's models extracted by every method, the same in each part.
+    members.erase(std::remove_if(members.begin(), members.end(),
+                                 [&](const ExtractedModel& m) {
+                                   return eligible->count(m.model_id) == 0;
+                                 }),
+                  members.end());
+  }
   // Parsed once, for training and encoding; the stored bytes are let go.
-  std::vector<v1::LocalFeatures> features(members->size());
-  for (std::size_t i = 0; i < members->size(); ++i) {
-    ExtractedModel& m = (*members)[i];
+  std::vector<v1::LocalFeatures> features(members.size());
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    ExtractedModel& m = members[i];
     if (!features[i].ParseFromString(m.features)) {
-      return fail(absl::DataLossError(
-          absl::StrCat("model ", m.model_id, ": stored features do not parse")));
+      return absl::DataLossError(
+          absl::StrCat("model ", m.model_id, ": stored features do not parse"));
     }
     std::string().swap(m.features);
   }
   // 1. The codebook, unless a resumed build trained it already or the method
   // is global (then the id only names this generation of the index).
-  const bool global =
-      FeatureMethodInfoOf(info->options.extractor.method).kind == DescriptorKind::kGlobal;
-  if (absl::Status trained = global ? absl::OkStatus() : Train(codebook_id, *info, features);
-      !trained.ok()) {
-    if (*stop_) return Done(collection);  // resumed after the restart
-    return fail(Prefixed(trained, "codebook training: "));
+  const bool global = FeatureMethodInfoOf(part.options.extractor.method).kind ==
+                      DescriptorKind::kGlobal;
+  if (!global) {
+    if (absl::Status trained = Train(codebook_id, part, features); !trained.ok()) {
+      return Prefixed(trained, "codebook training: ");
+    }
   }
   const absl::Time trained_at = absl::Now();
   // 2. Encode and index every model not yet indexed with this codebook.
-  std::vector<absl::Status> errors(members->size());
-  ParallelFor(members->size(), options_.max_in_flight, [&](std::size_t i) {
-    const ExtractedModel& m = (*members)[i];
+  std::vector<absl::Status> errors(members.size());
+  ParallelFor(members.size(), options_.max_in_flight, [&](std::size_t i) {
+    const ExtractedModel& m = members[i];
     if (m.indexed_codebook == codebook_id || *stop_) return;
-    absl::StatusOr<IndexSignature> signature = workers_->Encode(*info, codebook_id, features[i]);
+    absl::StatusOr<IndexSignature> signature = workers_->Encode(part, codebook_id, features[i]);
     errors[i] = signature.ok()
-                    ? workers_->AddToIndex(collection, m.model_id, m.ordinal, m.label, *signature)
+                    ? workers_->AddToIndex(part.name, m.model_id, m.ordinal, m.label, *signature)
                     : signature.status();
-    if (errors[i].ok()) errors[i] = store_->MarkIndexed({collection, m.model_id}, codebook_id);
+    if (errors[i].ok()) errors[i] = store_->MarkIndexed({part.name, m.model_id}, codebook_id);
   });
-  if (*stop_) return Done(collection);  // resumed after the restart
-  for (std::size_t i = 0; i < members->size(); ++i) {
+  if (*stop_) return absl::CancelledError("stopping");
+  for (std::size_t i = 0; i < members.size(); ++i) {
     if (!errors[i].ok()) {
-      return fail(Prefixed(errors[i], absl::StrCat("model ", (*members)[i].model_id, ": ")));
+      return Prefixed(errors[i], absl::StrCat("model ", members[i].model_id, ": "));
     }
   }
-  if (absl::Status s = store_->SetCodebook(collection, codebook_id); !s.ok()) return fail(s);
-  absl::StatusOr<ModelCounts> counts = store_->CountModels(collection, codebook_id);
-  const uint64_t failed = counts.ok() ? counts->failed : 0;
-  MESHSEEK_LOG(INFO) << "coordinator: " << job_id << ": " << members->size()
+  MESHSEEK_RETURN_IF_ERROR(store_->SetCodebook(part.name, codebook_id));
+  MESHSEEK_LOG(INFO) << "coordinator: " << job_id << ": " << part.name << ": " << members.size()
                      << " models; features loaded and codebook trained in "
                      << absl::FormatDuration(trained_at - start) << ", encoded and indexed in "
                      << absl::FormatDuration(absl::Now() - trained_at);
-  std::string message =
-      absl::StrCat(members->size(), " models indexed with codebook ", codebook_id);
+  return absl::OkStatus();
+}
+
+void BuildRunner::Run(const std::string& job_id, const std::string& collection) {
+  auto fail = [&](const absl::Status& status) {
+    MESHSEEK_LOG(ERROR) << "coordinator: " << job_id << " failed: " << status;
+    (void)store_->FinishJob(job_id, v1::JOB_STATE_FAILED, status.ToString());
+    Done(collection);
+  };
+  absl::StatusOr<CollectionPlan> plan = LoadCollectionPlan(store_, collection);
+  if (!plan.ok()) return fail(plan.status());
+  // A fused collection indexes the models every method extracted.
+  std::optional<std::set<std::string>> eligible;
+  if (plan->fused()) {
+    eligible.emplace();
+    v1::ListCollectionModelsRequest list;
+    list.set_collection(collection);
+    list.set_state(v1::MODEL_STATE_EXTRACTED);
+    list.set_page_size(1000);
+    do {
+      absl::StatusOr<v1::ListCollectionModelsResponse> page =
+          store_->ListModels(list, plan->PartNames());
+      if (!page.ok()) return fail(page.status());
+      for (const v1::ModelInfo& m : page->models()) eligible->insert(m.model_id());
+      list.set_page_token(page->next_page_token());
+    } while (!list.page_token().empty());
+  }
+  for (const CollectionInfo& part : plan->parts) {
+    const absl::Status built = BuildPart(job_id, part, eligible);
+    if (*stop_) return Done(collection);  // resumed after the restart
+    if (!built.ok()) {
+      return fail(plan->fused() ? Prefixed(built, absl::StrCat(part.name, ": ")) : built);
+    }
+  }
+  // 3. A rescaled collection's ranking state, from the parts just indexed.
+  const std::string codebook_id = absl::StrCat(collection, "@", job_id);
+  if (plan->options.rescaled()) {
+    const absl::Time start = absl::Now();
+    for (CollectionInfo& part : plan->parts) part.codebook_id = absl::StrCat(part.name, "@", job_id);
+    absl::StatusOr<RankingState> state = ComputeRankingState(workers_->index(), *plan);
+    if (*stop_) return Done(collection);
+    if (!state.ok()) return fail(Prefixed(state.status(), "ranking: "));
+    if (absl::Status s = store_->SetRanking(collection, job_id, state->Serialize()); !s.ok()) {
+      return fail(s);
+    }
+    MESHSEEK_LOG(INFO) << "coordinator: " << job_id << ": ranking state of "
+                       << state->model_ids.size() << " models in "
+                       << absl::FormatDuration(absl::Now() - start);
+  }
+  if (absl::Status s = store_->SetCodebook(collection, codebook_id); !s.ok()) return fail(s);
+  absl::StatusOr<ModelCounts> counts = store_->CountModels(plan->PartNames(), job_id);
+  const uint64_t failed = counts.ok() ? counts->failed : 0;
+  const uint64_t indexed = counts.ok() ? counts->indexed : 0;
+  std::string message = absl::StrCat(indexed, " models indexed with codebook ", codebook_id);
+  if (plan->fused()) {
+    message = absl::StrCat(indexed, " models indexed by ", plan->options.MethodName(),
+                           " (build ", job_id, ")");
+  }
   if (failed > 0) {
     absl::StrAppend(&message, "; ", failed, " failed models left out (meshseek status --collection ",
                     collection, " lists them)");

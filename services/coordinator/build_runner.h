@@ -1,6 +1,8 @@
 // Build jobs: train the codebook on every extracted model's stored
 // descriptors, in ingest order (the same input as the in-process pipeline),
-// then encode and index every model. The codebook id is derived from the job
+// then encode and index every model; for a fused collection, each member in
+// turn (the models every method extracted), then, for a fused or re-ranked
+// collection, its ranking state (ranking.h). The codebook id is derived from the job
 // ("<collection>@<job>") and each model records the codebook it was indexed
 // with, so a build interrupted by a restart resumes where it was
 // (ResumeInterrupted). Failed models are left out, and the job's message
@@ -9,6 +11,7 @@
 #define MESHSEEK_SERVICES_COORDINATOR_BUILD_RUNNER_H_
 
 #include <atomic>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
@@ -43,6 +46,11 @@ class BuildRunner {
 
  private:
   void Run(const std::string& job_id, const std::string& collection);
+  // Trains (unless global) and indexes one part of a collection with the
+  // codebook "<part>@<job>": its extracted models, or those in `eligible`.
+  absl::Status BuildPart(const std::string& job_id,
+                         const CollectionInfo& part,
+                         const std::optional<std::set<std::string>>& eligible);
   absl::Status Train(const std::string& codebook_id,
                      const CollectionInfo& info,
                      const std::vector<v1::LocalFeatures>& features);

@@ -43,6 +43,12 @@ constexpr const char* kSchema2 = R"sql(
   CREATE INDEX models_by_state_in_order ON models (collection, state, ordinal);
 )sql";
 
+// Version 3: the ranking state of fused and re-ranked collections.
+constexpr const char* kSchema3 = R"sql(
+  CREATE TABLE rankings (
+    collection TEXT PRIMARY KEY, build TEXT NOT NULL, state BLOB NOT NULL);
+)sql";
+
 // Version 1 fingerprinted meshes with the mistaken FNV basis: recompute them,
 // or every retried ingest of an old model would be "another mesh".
 absl::Status RecomputeFingerprints(Database* db) {
@@ -78,6 +84,7 @@ absl::Status MigrateCoordinatorSchema(Database* db) {
       MESHSEEK_RETURN_IF_ERROR(db->Execute(kSchema2));
       MESHSEEK_RETURN_IF_ERROR(RecomputeFingerprints(db));
     }
+    if (to == 3) MESHSEEK_RETURN_IF_ERROR(db->Execute(kSchema3));
     MESHSEEK_RETURN_IF_ERROR(db->SetUserVersion(to));
     MESHSEEK_RETURN_IF_ERROR(transaction.Commit());
     if (version > 0) MESHSEEK_LOG(INFO) << db->path() << ": schema migrated to version " << to;

@@ -4,7 +4,10 @@
 //      that release, which stored no version, is taken as version 1);
 //   2  per-model attempts and retry time, indexes for what the dispatchers
 //      and job counts scan, and mesh fingerprints recomputed with the correct
-//      FNV-1a offset basis (version 1 used one a digit short).
+//      FNV-1a offset basis (version 1 used one a digit short);
+//   3  rankings: what the build of a fused or re-ranked collection leaves for
+//      its queries (each method's scale, the models in node order, the
+//      neighbour graph), one row per collection.
 // A database of a newer version than this code knows is refused.
 #ifndef MESHSEEK_SERVICES_COORDINATOR_COORDINATOR_SCHEMA_H_
 #define MESHSEEK_SERVICES_COORDINATOR_COORDINATOR_SCHEMA_H_
@@ -18,7 +21,7 @@
 namespace meshseek {
 
 /// The schema version this code writes.
-inline constexpr int64_t kCoordinatorSchemaVersion = 2;
+inline constexpr int64_t kCoordinatorSchemaVersion = 3;
 
 /// Brings `db` to kCoordinatorSchemaVersion; FailedPrecondition for a newer
 /// one.

@@ -68,13 +68,24 @@ void CoordinatorService::Stop() {
 
 // ---------------------------------------------------------------- collections
 
+absl::StatusOr<CollectionPlan> CoordinatorService::PublicPlan(const std::string& name) {
+  MESHSEEK_ASSIGN_OR_RETURN(CollectionPlan plan, LoadCollectionPlan(store_.get(), name));
+  if (plan.member) {
+    return absl::InvalidArgumentError(absl::StrCat("collection '", name, "' is a member of '",
+                                                   name.substr(0, name.find('~')),
+                                                   "': use that one"));
+  }
+  return plan;
+}
+
 absl::StatusOr<v1::Collection> CoordinatorService::DescribeCollection(const std::string& name) {
-  MESHSEEK_ASSIGN_OR_RETURN(const StoredCollection stored, store_->GetCollection(name));
-  MESHSEEK_ASSIGN_OR_RETURN(const ModelCounts counts, store_->CountModels(name, stored.codebook_id));
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionPlan plan, LoadCollectionPlan(store_.get(), name));
+  MESHSEEK_ASSIGN_OR_RETURN(const ModelCounts counts,
+                            store_->CountModels(plan.PartNames(), plan.build()));
   v1::Collection collection;
   collection.set_name(name);
-  *collection.mutable_params() = stored.params;
-  collection.set_codebook_id(stored.codebook_id);
+  *collection.mutable_params() = plan.params;
+  collection.set_codebook_id(plan.codebook_id);
   collection.set_models(counts.models);
   collection.set_extracted(counts.extracted);
   collection.set_indexed(counts.indexed);
@@ -89,29 +100,36 @@ grpc::Status CoordinatorService::CreateCollection(grpc::ServerContext*,
   if (absl::Status name = CheckName("collection name", request->name(), 128, true); !name.ok()) {
     return rpc::ToGrpcStatus(name);
   }
-  absl::StatusOr<RetrievalPipelineOptions> valid =
-      rpc::PipelineOptionsFromParams(request->params());
+  absl::StatusOr<CollectionOptions> valid = rpc::CollectionOptionsFromParams(request->params());
   if (!valid.ok()) {
     return rpc::ToGrpcStatus(Prefixed(valid.status(), absl::StrCat("collection '", request->name(), "': ")));
   }
-  // Stored canonical: every parameter of the method with its value, so the
-  // collection keeps its meaning when a default changes, and creating it
-  // again with the same parameters however written is not a conflict.
+  // Stored canonical: every parameter with its value, so the collection
+  // keeps its meaning when a default changes, and creating it again with the
+  // same parameters however written is not a conflict.
   v1::PipelineParams canonical;
-  rpc::PipelineParamsToProto(*valid, &canonical);
+  rpc::CollectionParamsToProto(*valid, &canonical);
   if (absl::StatusOr<StoredCollection> existing = store_->GetCollection(request->name());
       existing.ok()) {
-    absl::StatusOr<RetrievalPipelineOptions> stored =
-        rpc::PipelineOptionsFromParams(existing->params);
+    absl::StatusOr<CollectionOptions> stored = rpc::CollectionOptionsFromParams(existing->params);
     v1::PipelineParams stored_canonical;
-    if (stored.ok()) rpc::PipelineParamsToProto(*stored, &stored_canonical);
+    if (stored.ok()) rpc::CollectionParamsToProto(*stored, &stored_canonical);
     if (!stored.ok() || stored_canonical.SerializeAsString() != canonical.SerializeAsString()) {
       return grpc::Status(
           grpc::StatusCode::ALREADY_EXISTS,
           absl::StrCat("collection '", request->name(), "' exists with other parameters"));
     }
-  } else if (absl::Status s = store_->CreateCollection(request->name(), canonical); !s.ok()) {
-    return rpc::ToGrpcStatus(s);
+  } else {
+    // A fused collection and its members, one per method, together.
+    std::vector<std::pair<std::string, v1::PipelineParams>> rows = {{request->name(), canonical}};
+    if (valid->fused()) {
+      for (const RetrievalPipelineOptions& method : valid->methods) {
+        v1::PipelineParams params;
+        rpc::PipelineParamsToProto(method, &params);
+        rows.emplace_back(MemberCollectionName(request->name(), method.extractor.method), params);
+      }
+    }
+    if (absl::Status s = store_->CreateCollections(rows); !s.ok()) return rpc::ToGrpcStatus(s);
   }
   absl::StatusOr<v1::Collection> collection = DescribeCollection(request->name());
   if (!collection.ok()) return rpc::ToGrpcStatus(collection.status());
@@ -131,10 +149,10 @@ grpc::Status CoordinatorService::GetCollection(grpc::ServerContext*,
 grpc::Status CoordinatorService::ListModels(grpc::ServerContext*,
                                             const v1::ListCollectionModelsRequest* request,
                                             v1::ListCollectionModelsResponse* response) {
-  if (absl::Status s = store_->GetCollection(request->collection()).status(); !s.ok()) {
-    return rpc::ToGrpcStatus(s);
-  }
-  absl::StatusOr<v1::ListCollectionModelsResponse> models = store_->ListModels(*request);
+  absl::StatusOr<CollectionPlan> plan = PublicPlan(request->collection());
+  if (!plan.ok()) return rpc::ToGrpcStatus(plan.status());
+  absl::StatusOr<v1::ListCollectionModelsResponse> models = store_->ListModels(
+      *request, plan->fused() ? plan->PartNames() : std::vector<std::string>());
   if (!models.ok()) return rpc::ToGrpcStatus(models.status());
   *response = *std::move(models);
   return grpc::Status::OK;
@@ -169,8 +187,9 @@ grpc::Status CoordinatorService::WatchJob(grpc::ServerContext* context,
 
 // --------------------------------------------------------------------- ingest
 
-absl::StatusOr<v1::IngestAck> CoordinatorService::AcceptModel(const v1::IngestRequest& request,
-                                                              const std::string& job_id) {
+absl::StatusOr<v1::IngestAck> CoordinatorService::AcceptModel(
+    const v1::IngestRequest& request, const std::vector<std::string>& parts,
+    const std::string& job_id) {
   MESHSEEK_RETURN_IF_ERROR(CheckName("model id", request.model_id(), 256, false));
   if (request.label().size() > 256) {
     return absl::InvalidArgumentError(absl::StrCat("model ", request.model_id(), ": label of ",
@@ -183,9 +202,9 @@ absl::StatusOr<v1::IngestAck> CoordinatorService::AcceptModel(const v1::IngestRe
   rpc::MeshToProto(*mesh, &stored);
   MESHSEEK_ASSIGN_OR_RETURN(
       const CoordinatorStore::AddedModel added,
-      store_->AddModel({request.collection(), request.model_id()}, request.label(),
-                       stored.SerializeAsString(), job_id));
-  if (added.created) dispatcher_.ModelAdded();
+      store_->AddModel(parts, request.model_id(), request.label(), stored.SerializeAsString(),
+                       job_id));
+  if (added.rows > 0) dispatcher_.ModelAdded(added.rows);
   v1::IngestAck ack;
   ack.set_model_id(request.model_id());
   ack.set_job_id(added.job_id);
@@ -198,13 +217,14 @@ grpc::Status CoordinatorService::Ingest(
     grpc::ServerReaderWriter<v1::IngestAck, v1::IngestRequest>* stream) {
   std::string job_id;
   std::string collection;
+  std::vector<std::string> parts;  // where its models are stored
   v1::IngestRequest request;
   grpc::Status result = grpc::Status::OK;
   while (stream->Read(&request)) {
     if (job_id.empty()) {
-      if (absl::Status s = store_->GetCollection(request.collection()).status(); !s.ok()) {
-        return rpc::ToGrpcStatus(s);
-      }
+      absl::StatusOr<CollectionPlan> plan = PublicPlan(request.collection());
+      if (!plan.ok()) return rpc::ToGrpcStatus(plan.status());
+      parts = plan->PartNames();
       absl::StatusOr<std::string> job = store_->NewJob("ingest", request.collection(), 0);
       if (!job.ok()) return rpc::ToGrpcStatus(job.status());
       job_id = *job;
@@ -221,7 +241,7 @@ grpc::Status CoordinatorService::Ingest(
       result = grpc::Status(grpc::StatusCode::CANCELLED, "ingest cancelled");
       break;
     }
-    absl::StatusOr<v1::IngestAck> ack = AcceptModel(request, job_id);
+    absl::StatusOr<v1::IngestAck> ack = AcceptModel(request, parts, job_id);
     if (!ack.ok()) {
       result = rpc::ToGrpcStatus(ack.status());
       break;
@@ -253,109 +273,24 @@ grpc::Status CoordinatorService::Build(grpc::ServerContext*,
 
 // ------------------------------------------------------- query, remove, eval
 
-grpc::Status CoordinatorService::Query(grpc::ServerContext*,
-                                       const v1::QueryRequest* request,
-                                       v1::QueryResponse* response) {
-  if (request->top_k() == 0) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "query: top_k must be at least 1");
-  }
-  absl::StatusOr<CollectionInfo> info = LoadCollection(store_.get(), request->collection());
-  if (!info.ok()) return rpc::ToGrpcStatus(info.status());
-  if (info->codebook_id.empty()) {
-    return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
-                        absl::StrCat("collection '", request->collection(), "' is not built yet"));
-  }
-  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request->mesh(), options_.mesh_limits);
-  if (!mesh.ok()) return rpc::ToGrpcStatus(Prefixed(mesh.status(), "query: "));
-  v1::Mesh arrays;
-  rpc::MeshToProto(*mesh, &arrays);
-  absl::StatusOr<v1::LocalFeatures> features = workers_.Extract(arrays, *info, "query");
-  if (!features.ok()) return rpc::ToGrpcStatus(features.status());
-  absl::StatusOr<IndexSignature> signature = workers_.Encode(*info, info->codebook_id, *features);
-  if (!signature.ok()) return rpc::ToGrpcStatus(signature.status());
-  v1::SearchRequest search;
-  search.set_collection(request->collection());
-  if (signature->descriptor.has_value()) {
-    *search.mutable_global_descriptor() = *signature->descriptor;
-  } else {
-    *search.mutable_histogram() = signature->histogram;
-  }
-  search.set_top_k(request->top_k());
-  search.set_candidates(request->candidates());
-  search.set_kl_epsilon(info->options.kl.epsilon);
-  absl::StatusOr<std::vector<v1::ScoredModel>> found = workers_.index()->Search(search);
-  if (!found.ok()) return rpc::ToGrpcStatus(found.status());
-  for (v1::ScoredModel& m : *found) *response->add_results() = std::move(m);
-  response->set_query_features(features->count());
-  return grpc::Status::OK;
-}
-
 grpc::Status CoordinatorService::RemoveModel(grpc::ServerContext*,
                                              const v1::RemoveModelFromCollectionRequest* request,
                                              v1::RemoveModelFromCollectionResponse* response) {
-  if (absl::Status s = store_->GetCollection(request->collection()).status(); !s.ok()) {
-    return rpc::ToGrpcStatus(s);
+  absl::StatusOr<CollectionPlan> plan = PublicPlan(request->collection());
+  if (!plan.ok()) return rpc::ToGrpcStatus(plan.status());
+  bool removed = false;
+  for (const std::string& part : plan->PartNames()) {
+    // The index first: a failure there leaves the model in both, and the
+    // removal can simply be retried.
+    absl::StatusOr<bool> unindexed = workers_.index()->Remove(part, request->model_id());
+    if (!unindexed.ok()) return rpc::ToGrpcStatus(unindexed.status());
+    absl::StatusOr<std::optional<ModelState>> state =
+        store_->RemoveModel({part, request->model_id()});
+    if (!state.ok()) return rpc::ToGrpcStatus(state.status());
+    if (*state == ModelState::kPending) dispatcher_.PendingModelRemoved();
+    removed = removed || state->has_value();
   }
-  // The index first: a failure there leaves the model in both, and the
-  // removal can simply be retried.
-  absl::StatusOr<bool> removed =
-      workers_.index()->Remove(request->collection(), request->model_id());
-  if (!removed.ok()) return rpc::ToGrpcStatus(removed.status());
-  absl::StatusOr<std::optional<ModelState>> state =
-      store_->RemoveModel({request->collection(), request->model_id()});
-  if (!state.ok()) return rpc::ToGrpcStatus(state.status());
-  if (*state == ModelState::kPending) dispatcher_.PendingModelRemoved();
-  response->set_removed(state->has_value());
-  return grpc::Status::OK;
-}
-
-grpc::Status CoordinatorService::Evaluate(grpc::ServerContext* context,
-                                          const v1::EvaluateRequest* request,
-                                          grpc::ServerWriter<v1::EvaluateRow>* writer) {
-  absl::StatusOr<v1::Collection> collection = DescribeCollection(request->collection());
-  if (!collection.ok()) return rpc::ToGrpcStatus(collection.status());
-  if (collection->codebook_id().empty() || collection->indexed() != collection->extracted() ||
-      collection->pending() > 0) {
-    return grpc::Status(
-        grpc::StatusCode::FAILED_PRECONDITION,
-        absl::StrCat("collection '", request->collection(), "' has ", collection->extracted(),
-                     " extracted models of which ", collection->indexed(),
-                     " are indexed with its current codebook, and ", collection->pending(),
-                     " pending; build it first"));
-  }
-  absl::StatusOr<CollectionInfo> info = LoadCollection(store_.get(), request->collection());
-  if (!info.ok()) return rpc::ToGrpcStatus(info.status());
-  std::map<std::string, uint32_t> feature_counts;
-  v1::ListCollectionModelsRequest list;
-  list.set_collection(request->collection());
-  list.set_state(v1::MODEL_STATE_EXTRACTED);
-  list.set_page_size(1000);
-  do {
-    absl::StatusOr<v1::ListCollectionModelsResponse> page = store_->ListModels(list);
-    if (!page.ok()) return rpc::ToGrpcStatus(page.status());
-    for (const v1::ModelInfo& m : page->models()) feature_counts[m.model_id()] = m.features();
-    list.set_page_token(page->next_page_token());
-  } while (!list.page_token().empty());
-  v1::EvaluateRow out;
-  uint64_t rows = 0;
-  const absl::Status streamed = workers_.index()->ForEachDistanceRow(
-      request->collection(), info->options.kl.epsilon,
-      [&](const IndexShards::Row& row) -> absl::Status {
-        if (context->IsCancelled()) return absl::CancelledError("evaluate: cancelled");
-        out.set_model_id(row.model->model_id());
-        out.set_label(row.model->label());
-        out.mutable_distances()->Assign(row.distances.begin(), row.distances.end());
-        out.set_features(feature_counts[row.model->model_id()]);
-        if (!writer->Write(out)) return absl::CancelledError("evaluate: client went away");
-        ++rows;
-        return absl::OkStatus();
-      });
-  if (!streamed.ok()) return rpc::ToGrpcStatus(streamed);
-  if (rows != collection->indexed()) {
-    return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
-                        absl::StrCat("index returned ", rows, " rows for ", collection->indexed(),
-                                     " indexed models; build again"));
-  }
+  response->set_removed(removed);
   return grpc::Status::OK;
 }
 

@@ -12,7 +12,17 @@
 //   workers              clients of the other services, deadlines, retries;
 //   dispatcher           PENDING models -> extract -> store (-> index);
 //   build_runner         build jobs: train, encode, index; resumable;
-//   coordinator_service  the RPC handlers (this file): validate, delegate.
+//   ranking              fused and re-ranked collections: the state a build
+//                        leaves, queries and rows ranked with it;
+//   coordinator_service  the RPC handlers (this file): validate, delegate;
+//                        coordinator_query.cc holds Query and Evaluate.
+//
+// A fused collection ("bfdsift+rld+lsf+lfd") is a collection of its own
+// parameters whose models live in one member collection per method
+// ("<name>~<method>", workers.h): ingest stores each model in every member,
+// the dispatchers extract each member's copy with its method, a build
+// builds every member and then the ranking state; queries and evaluation go
+// through the fused collection only.
 //
 // Ingest: each model of a stream is validated, stored PENDING and only then
 // acknowledged, so an acknowledged model survives kill -9; acknowledgements
@@ -23,15 +33,19 @@
 #define MESHSEEK_SERVICES_COORDINATOR_COORDINATOR_SERVICE_H_
 
 #include <atomic>
+#include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"
 #include "services/coordinator/build_runner.h"
 #include "services/coordinator/coordinator_options.h"
 #include "services/coordinator/coordinator_store.h"
 #include "services/coordinator/dispatcher.h"
+#include "services/coordinator/ranking.h"
 #include "services/coordinator/workers.h"
 
 namespace meshseek {
@@ -79,8 +93,13 @@ class CoordinatorService final : public v1::Coordinator::Service {
   CoordinatorService(const CoordinatorOptions& options, std::unique_ptr<CoordinatorStore> store);
 
   absl::StatusOr<v1::Collection> DescribeCollection(const std::string& name);
+  // The plan of a collection clients may use: InvalidArgument for a member.
+  absl::StatusOr<CollectionPlan> PublicPlan(const std::string& name);
+  // The ranking of a rescaled collection's last build, parsed once per build.
+  absl::StatusOr<std::shared_ptr<const Ranking>> RankingOf(const CollectionPlan& plan);
   // Ingest of one model: validates, stores, returns the ack.
   absl::StatusOr<v1::IngestAck> AcceptModel(const v1::IngestRequest& request,
+                                            const std::vector<std::string>& parts,
                                             const std::string& job_id);
 
   const CoordinatorOptions options_;
@@ -89,6 +108,10 @@ class CoordinatorService final : public v1::Coordinator::Service {
   Workers workers_;
   Dispatcher dispatcher_;
   BuildRunner builds_;
+
+  absl::Mutex rankings_mutex_;
+  std::map<std::string, std::shared_ptr<const Ranking>> rankings_
+      ABSL_GUARDED_BY(rankings_mutex_);
 };
 
 }  // namespace meshseek

@@ -4,7 +4,14 @@
 //   models      (mesh, label, ingest ordinal, state, attempts, error,
 //                stored local features, the codebook it was indexed with),
 //   jobs        (ingest and build jobs and their state),
+//   rankings    (what the build of a fused or re-ranked collection leaves for
+//                its queries: coordinator/ranking.h),
 //   settings    (facts fixed at first use: the number of index shards).
+//
+// A fused collection ("a+b") holds no models itself: its member collections
+// ("<name>~a", "<name>~b") hold a copy of each, extracted and indexed by
+// their method; the calls below take the member names where they count or
+// list a fused collection's models.
 //
 // The schema and its versions: coordinator_schema.h.
 //
@@ -60,6 +67,11 @@ struct StoredCollection {
   std::string codebook_id;  // empty before the first build
 };
 
+struct StoredRanking {
+  std::string build;  // the build job that computed it
+  std::string state;  // RankingState::Serialize
+};
+
 struct ModelCounts {
   uint64_t models = 0;
   uint64_t pending = 0;
@@ -99,12 +111,25 @@ class CoordinatorStore {
   // ------------------------------------------------------------ collections
   /// NotFound when absent; DataLoss when its stored parameters do not parse.
   absl::StatusOr<StoredCollection> GetCollection(const std::string& name);
-  /// Creates it, or nothing when it exists with the same parameters;
-  /// AlreadyExists when it exists with others.
-  absl::Status CreateCollection(const std::string& name, const v1::PipelineParams& params);
+  /// Creates each (name, parameters), or nothing for one that exists with
+  /// the same parameters, in one transaction; AlreadyExists (and nothing
+  /// created) when one exists with others.
+  absl::Status CreateCollections(
+      const std::vector<std::pair<std::string, v1::PipelineParams>>& collections);
   absl::Status SetCodebook(const std::string& collection, const std::string& codebook_id);
-  absl::StatusOr<ModelCounts> CountModels(const std::string& collection,
-                                          const std::string& codebook_id);
+  /// The models of `collections` (one, or a fused collection's members),
+  /// each model once: pending while pending in any, failed when failed in
+  /// any, extracted when extracted in all, indexed when indexed by the build
+  /// job `build` (codebook "<collection>@<build>") in all; no model is
+  /// indexed for an empty `build`.
+  absl::StatusOr<ModelCounts> CountModels(const std::vector<std::string>& collections,
+                                          const std::string& build);
+  /// The ranking state of a fused or re-ranked collection, replacing the
+  /// previous build's.
+  absl::Status SetRanking(const std::string& collection,
+                          const std::string& build,
+                          const std::string& state);
+  absl::StatusOr<std::optional<StoredRanking>> GetRanking(const std::string& collection);
 
   // ------------------------------------------------------------------- jobs
   /// A RUNNING job with id "<kind>-<sequence>"; an ingest job starts with its
@@ -117,7 +142,8 @@ class CoordinatorStore {
   /// is pending.
   absl::Status CloseIngestStream(const std::string& job_id);
   /// The job with its progress (models counted for ingest jobs, models
-  /// indexed with the job's codebook for builds) and up to 20 errors.
+  /// indexed with the job's codebook for builds, in every member of a fused
+  /// collection) and up to 20 errors.
   absl::StatusOr<v1::JobStatus> GetJob(const std::string& job_id);
   /// (job id, collection) of every RUNNING build, to resume after a restart.
   absl::StatusOr<std::vector<std::pair<std::string, std::string>>> RunningBuilds();
@@ -126,11 +152,14 @@ class CoordinatorStore {
   struct AddedModel {
     bool created = false;
     std::string job_id;  // the job that first stored it
+    int rows = 0;        // PENDING rows stored now (created: at least one)
   };
-  /// Stores a new PENDING model (ordinal: the collection's next), or
-  /// acknowledges the same mesh and label again without change;
-  /// AlreadyExists when the id holds another mesh or label.
-  absl::StatusOr<AddedModel> AddModel(const ModelKey& key,
+  /// Stores a new PENDING model (ordinal: the collection's next) in each of
+  /// `collections` (one, or a fused collection's members) in one
+  /// transaction, or acknowledges the same mesh and label again without
+  /// change; AlreadyExists when the id holds another mesh or label.
+  absl::StatusOr<AddedModel> AddModel(const std::vector<std::string>& collections,
+                                      const std::string& model_id,
                                       const std::string& label,
                                       const std::string& mesh,
                                       const std::string& job_id);
@@ -163,8 +192,12 @@ class CoordinatorStore {
 
   /// Every EXTRACTED model of the collection in ingest order.
   absl::StatusOr<std::vector<ExtractedModel>> ExtractedModels(const std::string& collection);
-  /// A page of the collection's models (see ListCollectionModelsRequest).
-  absl::StatusOr<v1::ListCollectionModelsResponse> ListModels(const v1::ListCollectionModelsRequest& request);
+  /// A page of the collection's models (see ListCollectionModelsRequest):
+  /// of request.collection, or with `members` (a fused collection's) each
+  /// model once, in the state CountModels gives it, with its members' errors
+  /// and feature counts summed.
+  absl::StatusOr<v1::ListCollectionModelsResponse> ListModels(
+      const v1::ListCollectionModelsRequest& request, const std::vector<std::string>& members = {});
 
  private:
   explicit CoordinatorStore(std::unique_ptr<Database> db) : db_(std::move(db)) {}

@@ -55,37 +55,37 @@ TEST_F(CoordinatorStoreTest, RefusesANewerSchemaAndAnotherShardCount) {
   }
   auto newer = CoordinatorStore::Open(dir_.string(), 2);
   EXPECT_EQ(newer.status().code(), absl::StatusCode::kFailedPrecondition);
-  EXPECT_THAT(newer.status().message(), HasSubstr("schema version 3"));
+  EXPECT_THAT(newer.status().message(), HasSubstr(absl::StrCat("schema version ", kCoordinatorSchemaVersion + 1)));
 }
 
 TEST_F(CoordinatorStoreTest, SameModelAgainIsAcknowledgedAnotherIsRefused) {
   auto store = OpenStore();
-  ASSERT_TRUE(store->CreateCollection("c", Params()).ok());
-  EXPECT_TRUE(store->CreateCollection("c", Params()).ok());
+  ASSERT_TRUE(store->CreateCollections({{"c", Params()}}).ok());
+  EXPECT_TRUE(store->CreateCollections({{"c", Params()}}).ok());
   v1::PipelineParams other = Params();
   other.set_method(v1::FEATURE_METHOD_RLD);
-  EXPECT_EQ(store->CreateCollection("c", other).code(), absl::StatusCode::kAlreadyExists);
+  EXPECT_EQ(store->CreateCollections({{"c", other}}).code(), absl::StatusCode::kAlreadyExists);
   const std::string job = store->NewJob("ingest", "c", 0).value();
   EXPECT_EQ(job, "ingest-1");
-  auto first = store->AddModel({"c", "m"}, "cat", "mesh bytes", job);
+  auto first = store->AddModel({"c"}, "m", "cat", "mesh bytes", job);
   ASSERT_TRUE(first.ok());
   EXPECT_TRUE(first->created);
-  auto again = store->AddModel({"c", "m"}, "cat", "mesh bytes", "ingest-2");
+  auto again = store->AddModel({"c"}, "m", "cat", "mesh bytes", "ingest-2");
   ASSERT_TRUE(again.ok());
   EXPECT_FALSE(again->created);
   EXPECT_EQ(again->job_id, job);
-  EXPECT_EQ(store->AddModel({"c", "m"}, "dog", "mesh bytes", job).status().code(),
+  EXPECT_EQ(store->AddModel({"c"}, "m", "dog", "mesh bytes", job).status().code(),
             absl::StatusCode::kAlreadyExists);
-  EXPECT_EQ(store->AddModel({"c", "m"}, "cat", "other bytes", job).status().code(),
+  EXPECT_EQ(store->AddModel({"c"}, "m", "cat", "other bytes", job).status().code(),
             absl::StatusCode::kAlreadyExists);
 }
 
 TEST_F(CoordinatorStoreTest, IngestJobFinishesWhenItsLastModelEndsNotWhenRead) {
   auto store = OpenStore();
-  ASSERT_TRUE(store->CreateCollection("c", Params()).ok());
+  ASSERT_TRUE(store->CreateCollections({{"c", Params()}}).ok());
   const std::string job = store->NewJob("ingest", "c", 0).value();
-  ASSERT_TRUE(store->AddModel({"c", "a"}, "", "A", job).ok());
-  ASSERT_TRUE(store->AddModel({"c", "b"}, "", "B", job).ok());
+  ASSERT_TRUE(store->AddModel({"c"}, "a", "", "A", job).ok());
+  ASSERT_TRUE(store->AddModel({"c"}, "b", "", "B", job).ok());
   EXPECT_EQ(store->PendingCount(), 2u);
   ASSERT_TRUE(store->CloseIngestStream(job).ok());
   EXPECT_EQ(store->GetJob(job)->state(), v1::JOB_STATE_RUNNING);
@@ -100,7 +100,7 @@ TEST_F(CoordinatorStoreTest, IngestJobFinishesWhenItsLastModelEndsNotWhenRead) {
   EXPECT_EQ(status.done(), 2u);
   EXPECT_EQ(status.failed(), 1u);
   EXPECT_THAT(status.errors(), ElementsAre("model b: INVALID_ARGUMENT: no faces"));
-  const ModelCounts counts = store->CountModels("c", "").value();
+  const ModelCounts counts = store->CountModels({"c"}, "").value();
   EXPECT_EQ(counts.models, 2u);
   EXPECT_EQ(counts.extracted, 1u);
   EXPECT_EQ(counts.failed, 1u);
@@ -109,9 +109,9 @@ TEST_F(CoordinatorStoreTest, IngestJobFinishesWhenItsLastModelEndsNotWhenRead) {
 
 TEST_F(CoordinatorStoreTest, RemovingTheLastPendingModelFinishesItsJob) {
   auto store = OpenStore();
-  ASSERT_TRUE(store->CreateCollection("c", Params()).ok());
+  ASSERT_TRUE(store->CreateCollections({{"c", Params()}}).ok());
   const std::string job = store->NewJob("ingest", "c", 0).value();
-  ASSERT_TRUE(store->AddModel({"c", "a"}, "", "A", job).ok());
+  ASSERT_TRUE(store->AddModel({"c"}, "a", "", "A", job).ok());
   ASSERT_TRUE(store->CloseIngestStream(job).ok());
   EXPECT_EQ(store->RemoveModel({"c", "a"}).value(), ModelState::kPending);
   EXPECT_EQ(store->RemoveModel({"c", "a"}).value(), std::nullopt);
@@ -120,9 +120,9 @@ TEST_F(CoordinatorStoreTest, RemovingTheLastPendingModelFinishesItsJob) {
 
 TEST_F(CoordinatorStoreTest, ModelsInBackoffAreClaimedOnlyWhenDue) {
   auto store = OpenStore();
-  ASSERT_TRUE(store->CreateCollection("c", Params()).ok());
+  ASSERT_TRUE(store->CreateCollections({{"c", Params()}}).ok());
   const std::string job = store->NewJob("ingest", "c", 0).value();
-  for (const char* id : {"a", "b", "c"}) ASSERT_TRUE(store->AddModel({"c", id}, "", id, job).ok());
+  for (const char* id : {"a", "b", "c"}) ASSERT_TRUE(store->AddModel({"c"}, id, "", id, job).ok());
   const absl::Time now = absl::Now();
   ASSERT_TRUE(store->ScheduleRetry({"c", "a"}, 1, now + absl::Seconds(30), "UNAVAILABLE").ok());
   auto claimable = store->ClaimablePending(now, {{"c", "b"}}, 5).value();
@@ -135,10 +135,10 @@ TEST_F(CoordinatorStoreTest, ModelsInBackoffAreClaimedOnlyWhenDue) {
 
 TEST_F(CoordinatorStoreTest, ListModelsPagesInIngestOrderAndFiltersByState) {
   auto store = OpenStore();
-  ASSERT_TRUE(store->CreateCollection("c", Params()).ok());
+  ASSERT_TRUE(store->CreateCollections({{"c", Params()}}).ok());
   const std::string job = store->NewJob("ingest", "c", 0).value();
   for (int i = 0; i < 5; ++i) {
-    ASSERT_TRUE(store->AddModel({"c", absl::StrCat("m", i)}, "", absl::StrCat(i), job).ok());
+    ASSERT_TRUE(store->AddModel({"c"}, absl::StrCat("m", i), "", absl::StrCat(i), job).ok());
   }
   ASSERT_TRUE(store->MarkFailed({"c", "m1"}, 3, "gave up after 3 attempts: UNAVAILABLE").ok());
   ASSERT_TRUE(store->MarkFailed({"c", "m3"}, 1, "DATA_LOSS: damaged").ok());
@@ -206,14 +206,84 @@ TEST_F(CoordinatorStoreTest, FirstReleaseDatabaseIsMigrated) {
   }
   auto store = OpenStore();
   ASSERT_NE(store, nullptr);
-  auto again = store->AddModel({"c", "m"}, "cat", mesh, "ingest-2");
+  auto again = store->AddModel({"c"}, "m", "cat", mesh, "ingest-2");
   ASSERT_TRUE(again.ok()) << again.status();
   EXPECT_FALSE(again->created);
   const v1::JobStatus job = store->GetJob("ingest-1").value();
   EXPECT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED);
   EXPECT_EQ(job.message(), "1 models extracted");
-  EXPECT_EQ(store->CountModels("c", "").value().extracted, 1u);
+  EXPECT_EQ(store->CountModels({"c"}, "").value().extracted, 1u);
   EXPECT_EQ(store->NewJob("build", "c", 1).value(), "build-2");
+}
+
+// A fused collection's members hold a copy of every model, stored together;
+// counts and lists see each model once, failed when any copy failed.
+TEST_F(CoordinatorStoreTest, FusedMembersHoldEveryModelCountedOnce) {
+  auto store = OpenStore();
+  ASSERT_NE(store, nullptr);
+  v1::PipelineParams other = Params();
+  other.set_method(v1::FEATURE_METHOD_RLD);
+  ASSERT_TRUE(store->CreateCollections({{"f", Params()}, {"f~dld", Params()}, {"f~rld", other}}).ok());
+  // All or nothing: a conflict creates none.
+  EXPECT_EQ(store->CreateCollections({{"g", Params()}, {"f~rld", Params()}}).code(),
+            absl::StatusCode::kAlreadyExists);
+  EXPECT_EQ(store->GetCollection("g").status().code(), absl::StatusCode::kNotFound);
+
+  const std::vector<std::string> members = {"f~dld", "f~rld"};
+  const std::string job = store->NewJob("ingest", "f", 0).value();
+  for (const char* id : {"a", "b", "c"}) {
+    auto added = store->AddModel(members, id, "cat", id, job);
+    ASSERT_TRUE(added.ok() && added->created);
+    EXPECT_EQ(added->rows, 2);  // one PENDING row per member: the dispatcher counts both
+  }
+  EXPECT_FALSE(store->AddModel(members, "a", "cat", "a", job)->created);
+  EXPECT_EQ(store->AddModel(members, "a", "cat", "a", job)->rows, 0);
+  EXPECT_EQ(store->AddModel(members, "a", "dog", "a", job).status().code(),
+            absl::StatusCode::kAlreadyExists);
+  // a: extracted by both; b: by one, failed by the other; c: extracted by one.
+  ASSERT_TRUE(store->MarkExtracted({"f~dld", "a"}, "F", 10).ok());
+  ASSERT_TRUE(store->MarkExtracted({"f~rld", "a"}, "F", 20).ok());
+  ASSERT_TRUE(store->MarkExtracted({"f~dld", "b"}, "F", 10).ok());
+  ASSERT_TRUE(store->MarkFailed({"f~rld", "b"}, 1, "bad mesh").ok());
+  ASSERT_TRUE(store->MarkExtracted({"f~dld", "c"}, "F", 10).ok());
+  ASSERT_TRUE(store->MarkIndexed({"f~dld", "a"}, "f~dld@build-9").ok());
+  ASSERT_TRUE(store->MarkIndexed({"f~rld", "a"}, "f~rld@build-9").ok());
+  const ModelCounts counts = store->CountModels(members, "build-9").value();
+  EXPECT_EQ(counts.models, 3u);
+  EXPECT_EQ(counts.extracted, 1u);
+  EXPECT_EQ(counts.failed, 1u);
+  EXPECT_EQ(counts.pending, 1u);
+  EXPECT_EQ(counts.indexed, 1u);
+
+  v1::ListCollectionModelsRequest request;
+  request.set_collection("f");
+  const v1::ListCollectionModelsResponse all = store->ListModels(request, members).value();
+  ASSERT_EQ(all.models_size(), 3);
+  EXPECT_EQ(all.models(0).model_id(), "a");
+  EXPECT_EQ(all.models(0).state(), v1::MODEL_STATE_EXTRACTED);
+  EXPECT_EQ(all.models(0).features(), 30u);
+  EXPECT_EQ(all.models(1).state(), v1::MODEL_STATE_FAILED);
+  EXPECT_EQ(all.models(1).error(), "rld: bad mesh");
+  EXPECT_EQ(all.models(2).state(), v1::MODEL_STATE_PENDING);
+  request.set_state(v1::MODEL_STATE_EXTRACTED);
+  EXPECT_EQ(store->ListModels(request, members).value().models_size(), 1);
+
+  // A build's progress counts the members' models it indexed.
+  const std::string build = store->NewJob("build", "f", 2).value();
+  ASSERT_TRUE(store->MarkIndexed({"f~dld", "a"}, "f~dld@" + build).ok());
+  EXPECT_EQ(store->GetJob(build).value().done(), 1u);
+}
+
+TEST_F(CoordinatorStoreTest, RankingStateIsReplacedByTheNextBuild) {
+  auto store = OpenStore();
+  ASSERT_NE(store, nullptr);
+  EXPECT_FALSE(store->GetRanking("f").value().has_value());
+  ASSERT_TRUE(store->SetRanking("f", "build-1", "one").ok());
+  ASSERT_TRUE(store->SetRanking("f", "build-2", "two").ok());
+  const std::optional<StoredRanking> got = store->GetRanking("f").value();
+  ASSERT_TRUE(got.has_value());
+  EXPECT_EQ(got->build, "build-2");
+  EXPECT_EQ(got->state, "two");
 }
 
 }  // namespace

@@ -60,9 +60,9 @@ void Dispatcher::Join() {
   threads_.clear();
 }
 
-void Dispatcher::ModelAdded() {
+void Dispatcher::ModelAdded(int rows) {
   absl::MutexLock lock(&mutex_);
-  ++pending_;
+  pending_ += rows;
   changed_.SignalAll();
 }
 
@@ -119,7 +119,10 @@ bool Dispatcher::Claim(ModelKey* key) {
 }
 
 void Dispatcher::Process(const ModelKey& key) {
-  absl::StatusOr<CollectionInfo> info = LoadCollection(store_, key.collection);
+  // Models live in collections of one method (a fused collection's members).
+  absl::StatusOr<CollectionPlan> plan = LoadCollectionPlan(store_, key.collection);
+  absl::StatusOr<CollectionInfo> info =
+      plan.ok() ? LoadCollection(store_, key.collection) : plan.status();
   absl::StatusOr<std::optional<PendingModel>> pending = store_->LoadPending(key);
   if (!pending.ok()) {
     MESHSEEK_LOG(ERROR) << "coordinator: model " << key.model_id << ": " << pending.status();
@@ -171,8 +174,10 @@ void Dispatcher::Process(const ModelKey& key) {
     }
     return;
   }
-  if (info->codebook_id.empty()) return;
-  // A built collection: index the new model with the current codebook.
+  // A built collection ranked by the index alone: index the new model with
+  // the current codebook. A fused or re-ranked one ranks the models of its
+  // last build (ranking.h): the new one waits for the next.
+  if (info->codebook_id.empty() || plan->member || plan->options.rescaled()) return;
   absl::StatusOr<IndexSignature> signature = workers_->Encode(*info, info->codebook_id, *features);
   absl::Status added =
       signature.ok() ? workers_->AddToIndex(

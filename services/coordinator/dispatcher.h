@@ -52,8 +52,9 @@ class Dispatcher {
   /// Wakes and joins the threads (after `stop` was set).
   void Join();
 
-  /// A model was stored PENDING (ingest) / deleted while PENDING (removal).
-  void ModelAdded();
+  /// `rows` model rows were stored PENDING (ingest: one per member of a
+  /// fused collection) / one was deleted while PENDING (removal).
+  void ModelAdded(int rows = 1);
   void PendingModelRemoved();
   /// Returns once fewer than max_pending models are pending, or when
   /// `cancelled()` or stop; true when there is room.

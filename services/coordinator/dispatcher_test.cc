@@ -75,12 +75,12 @@ TEST(DispatcherTest, ModelsEndExtractedOrFailedWithTheirReasonAndThenAllIsIdle) 
   ASSERT_TRUE(store.ok()) << store.status();
   v1::PipelineParams params;
   params.set_method(v1::FEATURE_METHOD_DLD);
-  ASSERT_TRUE((*store)->CreateCollection("c", params).ok());
+  ASSERT_TRUE((*store)->CreateCollections({{"c", params}}).ok());
   const std::string job = (*store)->NewJob("ingest", "c", 0).value();
   for (const char* id : {"good", "bad", "flaky"}) {
-    ASSERT_TRUE((*store)->AddModel({"c", id}, "", v1::Mesh().SerializeAsString(), job).ok());
+    ASSERT_TRUE((*store)->AddModel({"c"}, id, "", v1::Mesh().SerializeAsString(), job).ok());
   }
-  ASSERT_TRUE((*store)->AddModel({"c", "damaged"}, "", "\xff\xff not a mesh", job).ok());
+  ASSERT_TRUE((*store)->AddModel({"c"}, "damaged", "", "\xff\xff not a mesh", job).ok());
   ASSERT_TRUE((*store)->CloseIngestStream(job).ok());
 
   std::atomic<bool> stop{false};

@@ -121,76 +121,151 @@ absl::StatusOr<std::vector<v1::IndexedModel>> IndexShards::Export(std::size_t s,
   return models;
 }
 
-absl::Status IndexShards::ForEachDistanceRow(const std::string& collection,
-                                             double kl_epsilon,
-                                             const std::function<absl::Status(const Row&)>& fn) {
-  // 1. Every model, from every shard, in (ordinal, id) order.
-  std::vector<v1::IndexedModel> models;
+absl::StatusOr<std::vector<IndexShards::Scored>> IndexShards::QueryDistances(
+    const v1::DistancesRequest& request) {
+  std::vector<v1::DistancesResponse> answers(shards_.size());
+  std::vector<absl::Status> errors(shards_.size());
+  ParallelFor(shards_.size(), static_cast<int>(shards_.size()), [&](std::size_t s) {
+    errors[s] = rpc::CallWithRetry(shards_[s].get(), &v1::Index::Stub::Distances, request,
+                                   &answers[s], call_deadline_, retry_, stop_);
+  });
+  std::vector<Scored> all;
+  std::size_t not_found = 0;
   for (std::size_t s = 0; s < shards_.size(); ++s) {
-    MESHSEEK_ASSIGN_OR_RETURN(std::vector<v1::IndexedModel> part, Export(s, collection));
-    for (v1::IndexedModel& m : part) models.push_back(std::move(m));
+    if (errors[s].code() == absl::StatusCode::kNotFound) {
+      ++not_found;
+      continue;
+    }
+    if (!errors[s].ok()) {
+      return absl::Status(errors[s].code(),
+                          absl::StrCat("index shard ", s, ": ", errors[s].message()));
+    }
+    const v1::DistancesResponse& a = answers[s];
+    if (a.distances_size() != a.model_ids_size()) {
+      return absl::InternalError(absl::StrCat("index shard ", s, " answered ", a.distances_size(),
+                                              " distances for ", a.model_ids_size(), " models"));
+    }
+    for (int j = 0; j < a.model_ids_size(); ++j) all.push_back({a.model_ids(j), a.distances(j)});
   }
-  if (models.empty()) {
-    return absl::NotFoundError(absl::StrCat("index has no models in collection '", collection, "'"));
+  if (not_found == shards_.size()) return errors[0];
+  return all;
+}
+
+absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
+                                             const std::function<absl::Status(const Row&)>& fn,
+                                             const std::vector<std::size_t>* only_rows) {
+  // 1. Every model of every part, from every shard; the first part's in
+  //    (ordinal, id) order gives the rows and columns, the others must hold
+  //    the same models.
+  const std::size_t p_count = parts.size();
+  std::vector<std::vector<v1::IndexedModel>> models(p_count);
+  for (std::size_t p = 0; p < p_count; ++p) {
+    for (std::size_t s = 0; s < shards_.size(); ++s) {
+      MESHSEEK_ASSIGN_OR_RETURN(std::vector<v1::IndexedModel> part, Export(s, parts[p].collection));
+      for (v1::IndexedModel& m : part) models[p].push_back(std::move(m));
+    }
+    if (models[p].empty()) {
+      return absl::NotFoundError(
+          absl::StrCat("index has no models in collection '", parts[p].collection, "'"));
+    }
   }
-  std::sort(models.begin(), models.end(), Before);
-  const std::size_t n = models.size();
+  std::sort(models[0].begin(), models[0].end(), Before);
+  const std::size_t n = models[0].size();
   absl::flat_hash_map<std::string, std::size_t> column;
-  for (std::size_t i = 0; i < n; ++i) column[models[i].model_id()] = i;
+  for (std::size_t i = 0; i < n; ++i) column[models[0][i].model_id()] = i;
+  // entry[p][i]: part p's entry of the model of row i.
+  std::vector<std::vector<const v1::IndexedModel*>> entry(p_count,
+                                                          std::vector<const v1::IndexedModel*>(n));
+  for (std::size_t p = 0; p < p_count; ++p) {
+    std::size_t found = 0;
+    for (const v1::IndexedModel& m : models[p]) {
+      auto it = column.find(m.model_id());
+      if (it == column.end()) continue;
+      entry[p][it->second] = &m;
+      ++found;
+    }
+    if (found != n || models[p].size() != n) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "collections '", parts[0].collection, "' and '", parts[p].collection, "' hold ", n,
+          " and ", models[p].size(), " models, ", found, " in common; build again"));
+    }
+  }
 
   // 2. Blocks of rows: each shard gives the distances from the block's
-  //    histograms to its own models, placed into their columns.
-  std::vector<float> block;
-  for (std::size_t begin = 0; begin < n; begin += kMatrixBatch) {
-    const std::size_t end = std::min(n, begin + kMatrixBatch);
-    v1::DistancesRequest request;
-    request.set_collection(collection);
-    request.set_kl_epsilon(kl_epsilon);
-    for (std::size_t i = begin; i < end; ++i) {
-      if (models[i].has_global_descriptor()) {
-        *request.add_global_queries() = models[i].global_descriptor();
-      } else {
-        *request.add_queries() = models[i].histogram();
+  //    signatures to its own models, placed into their columns.
+  std::vector<std::size_t> rows;
+  if (only_rows != nullptr) {
+    for (std::size_t i : *only_rows) {
+      if (i >= n) {
+        return absl::InvalidArgumentError(absl::StrCat("row ", i, " of ", n, " models"));
       }
     }
-    block.assign((end - begin) * n, -1.0f);
-    std::size_t covered = 0;
-    for (std::size_t s = 0; s < shards_.size(); ++s) {
-      v1::DistancesResponse response;
-      const absl::Status status =
-          rpc::CallWithRetry(shards_[s].get(), &v1::Index::Stub::Distances, request, &response,
-                             call_deadline_, retry_, stop_);
-      if (status.code() == absl::StatusCode::kNotFound) continue;
-      if (!status.ok()) {
-        return absl::Status(status.code(), absl::StrCat("index shard ", s, ": ", status.message()));
-      }
-      const std::size_t m = static_cast<std::size_t>(response.model_ids_size());
-      if (static_cast<std::size_t>(response.distances_size()) != (end - begin) * m) {
-        return absl::InternalError(absl::StrCat("index shard ", s, " answered ",
-                                                response.distances_size(), " distances for ",
-                                                end - begin, " queries and ", m, " models"));
-      }
-      for (std::size_t j = 0; j < m; ++j) {
-        auto it = column.find(response.model_ids(static_cast<int>(j)));
-        // A model added after the export has no row: it waits for the next
-        // evaluation.
-        if (it == column.end()) continue;
-        ++covered;
-        for (std::size_t q = 0; q < end - begin; ++q) {
-          block[q * n + it->second] = response.distances(static_cast<int>(q * m + j));
+    rows = *only_rows;
+  } else {
+    rows.resize(n);
+    for (std::size_t i = 0; i < n; ++i) rows[i] = i;
+  }
+  std::vector<std::vector<float>> blocks(p_count);
+  for (std::size_t begin = 0; begin < rows.size(); begin += kMatrixBatch) {
+    const std::size_t end = std::min(rows.size(), begin + kMatrixBatch);
+    for (std::size_t p = 0; p < p_count; ++p) {
+      v1::DistancesRequest request;
+      request.set_collection(parts[p].collection);
+      request.set_kl_epsilon(parts[p].kl_epsilon);
+      for (std::size_t r = begin; r < end; ++r) {
+        const v1::IndexedModel& m = *entry[p][rows[r]];
+        if (m.has_global_descriptor()) {
+          *request.add_global_queries() = m.global_descriptor();
+        } else {
+          *request.add_queries() = m.histogram();
         }
       }
+      std::vector<float>& block = blocks[p];
+      block.assign((end - begin) * n, -1.0f);
+      std::size_t covered = 0;
+      for (std::size_t s = 0; s < shards_.size(); ++s) {
+        v1::DistancesResponse response;
+        const absl::Status status =
+            rpc::CallWithRetry(shards_[s].get(), &v1::Index::Stub::Distances, request, &response,
+                               call_deadline_, retry_, stop_);
+        if (status.code() == absl::StatusCode::kNotFound) continue;
+        if (!status.ok()) {
+          return absl::Status(status.code(),
+                              absl::StrCat("index shard ", s, ": ", status.message()));
+        }
+        const std::size_t m = static_cast<std::size_t>(response.model_ids_size());
+        if (static_cast<std::size_t>(response.distances_size()) != (end - begin) * m) {
+          return absl::InternalError(absl::StrCat("index shard ", s, " answered ",
+                                                  response.distances_size(), " distances for ",
+                                                  end - begin, " queries and ", m, " models"));
+        }
+        for (std::size_t j = 0; j < m; ++j) {
+          auto it = column.find(response.model_ids(static_cast<int>(j)));
+          // A model added after the export has no row: it waits for the
+          // next evaluation.
+          if (it == column.end()) continue;
+          ++covered;
+          for (std::size_t q = 0; q < end - begin; ++q) {
+            block[q * n + it->second] = response.distances(static_cast<int>(q * m + j));
+          }
+        }
+      }
+      if (covered != n) {
+        // A model removed (or a shard emptied) between the export and now.
+        return absl::AbortedError(absl::StrCat(
+            "collection '", parts[p].collection, "' changed while its distance matrix was ",
+            "assembled (", covered, " of ", n, " models answered); try again"));
+      }
     }
-    if (covered != n) {
-      // A model removed (or a shard emptied) between the export and now.
-      return absl::AbortedError(absl::StrCat("collection '", collection, "' changed while its ",
-                                             "distance matrix was assembled (", covered, " of ", n,
-                                             " models answered); try again"));
-    }
-    for (std::size_t i = begin; i < end; ++i) {
-      float* row = &block[(i - begin) * n];
-      row[i] = 0.0f;
-      MESHSEEK_RETURN_IF_ERROR(fn(Row{&models[i], absl::MakeConstSpan(row, n)}));
+    for (std::size_t r = begin; r < end; ++r) {
+      const std::size_t i = rows[r];
+      Row row{&models[0][i], {}};
+      for (std::size_t p = 0; p < p_count; ++p) {
+        float* distances = &blocks[p][(r - begin) * n];
+        distances[i] = 0.0f;
+        row.distances.push_back(absl::MakeConstSpan(distances, n));
+      }
+      MESHSEEK_RETURN_IF_ERROR(fn(row));
     }
   }
   return absl::OkStatus();

@@ -57,17 +57,37 @@ class IndexShards {
   /// The top_k nearest over every shard, ties by ordinal then id.
   absl::StatusOr<std::vector<v1::ScoredModel>> Search(const v1::SearchRequest& request);
 
-  /// One row of the all-pairs matrix.
-  struct Row {
-    const v1::IndexedModel* model;
-    absl::Span<const float> distances;  // to every model, in row order
+  /// A query's distance to one model.
+  struct Scored {
+    std::string model_id;
+    float distance;
   };
-  /// Calls fn for each model of the collection in (ordinal, id) order with
-  /// its distances to every model in the same order (0 to itself). Returns
-  /// early with fn's first error. NOT_FOUND when no shard has the collection.
-  absl::Status ForEachDistanceRow(const std::string& collection,
-                                  double kl_epsilon,
-                                  const std::function<absl::Status(const Row&)>& fn);
+  /// The distances from the request's one query to every model of its
+  /// collection, over every shard, in no particular order. NOT_FOUND when no
+  /// shard has the collection.
+  absl::StatusOr<std::vector<Scored>> QueryDistances(const v1::DistancesRequest& request);
+
+  /// A collection whose matrix is assembled, with its distance's epsilon.
+  struct Part {
+    std::string collection;
+    double kl_epsilon = 0;
+  };
+  /// One row of the all-pairs matrices of the parts.
+  struct Row {
+    const v1::IndexedModel* model;  // the first part's entry
+    /// Per part, the distances to every model in row order.
+    std::vector<absl::Span<const float>> distances;
+  };
+  /// Calls fn for each model of the parts (one collection, or a fused
+  /// collection's members, which hold the same models) in the first part's
+  /// (ordinal, id) order with each part's distances to every model in the
+  /// same order (0 to itself); with `only_rows`, for the rows at those
+  /// positions (increasing) only. Returns early with fn's first error.
+  /// NOT_FOUND when no shard has a part's collection; FAILED_PRECONDITION
+  /// when the parts hold different models.
+  absl::Status ForEachDistanceRow(const std::vector<Part>& parts,
+                                  const std::function<absl::Status(const Row&)>& fn,
+                                  const std::vector<std::size_t>* only_rows = nullptr);
 
  private:
   // Every model of `collection` on shard s (empty when it has none).

@@ -1,17 +1,68 @@
 #include "services/coordinator/workers.h"
 
+#include "absl/strings/str_cat.h"
 #include "common/base/status_macros.h"
 #include "common/rpc/convert.h"
 
 namespace meshseek {
 
-absl::StatusOr<CollectionInfo> LoadCollection(CoordinatorStore* store, const std::string& name) {
+std::string CollectionPlan::build() const {
+  const std::size_t at = codebook_id.rfind('@');
+  return at == std::string::npos ? "" : codebook_id.substr(at + 1);
+}
+
+std::vector<std::string> CollectionPlan::PartNames() const {
+  std::vector<std::string> names;
+  for (const CollectionInfo& part : parts) names.push_back(part.name);
+  return names;
+}
+
+std::string MemberCollectionName(const std::string& fused, FeatureMethod method) {
+  return absl::StrCat(fused, "~", FeatureMethodName(method));
+}
+
+bool IsMemberCollection(const std::string& name) {
+  return name.find('~') != std::string::npos;
+}
+
+absl::StatusOr<CollectionPlan> LoadCollectionPlan(CoordinatorStore* store,
+                                                  const std::string& name) {
   MESHSEEK_ASSIGN_OR_RETURN(StoredCollection stored, store->GetCollection(name));
-  CollectionInfo info;
-  info.params = std::move(stored.params);
-  info.codebook_id = std::move(stored.codebook_id);
-  MESHSEEK_ASSIGN_OR_RETURN(info.options, rpc::PipelineOptionsFromParams(info.params));
-  return info;
+  CollectionPlan plan;
+  plan.name = name;
+  plan.params = std::move(stored.params);
+  plan.codebook_id = std::move(stored.codebook_id);
+  plan.member = IsMemberCollection(name);
+  MESHSEEK_ASSIGN_OR_RETURN(plan.options, rpc::CollectionOptionsFromParams(plan.params));
+  if (!plan.fused()) {
+    CollectionInfo part;
+    part.name = name;
+    part.options = plan.options.methods.front();
+    rpc::PipelineParamsToProto(part.options, &part.params);
+    part.codebook_id = plan.codebook_id;
+    plan.parts.push_back(std::move(part));
+    return plan;
+  }
+  for (const RetrievalPipelineOptions& method : plan.options.methods) {
+    const std::string member = MemberCollectionName(name, method.extractor.method);
+    MESHSEEK_ASSIGN_OR_RETURN(StoredCollection part_stored, store->GetCollection(member));
+    CollectionInfo part;
+    part.name = member;
+    part.options = method;
+    rpc::PipelineParamsToProto(method, &part.params);
+    part.codebook_id = std::move(part_stored.codebook_id);
+    plan.parts.push_back(std::move(part));
+  }
+  return plan;
+}
+
+absl::StatusOr<CollectionInfo> LoadCollection(CoordinatorStore* store, const std::string& name) {
+  MESHSEEK_ASSIGN_OR_RETURN(CollectionPlan plan, LoadCollectionPlan(store, name));
+  if (plan.fused()) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("collection '", name, "' fuses ", plan.options.MethodName()));
+  }
+  return std::move(plan.parts.front());
 }
 
 Workers::Workers(const CoordinatorOptions& options, const std::atomic<bool>* stop)

@@ -10,8 +10,10 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
+#include "common/pipeline/collection_options.h"
 #include "common/pipeline/retrieval_pipeline.h"
 #include "common/rpc/client.h"
 #include "meshseek/v1/codebook.grpc.pb.h"
@@ -23,16 +25,47 @@
 
 namespace meshseek {
 
-/// A collection as the workers need it: stored parameters, the pipeline
-/// options they validate to, the current codebook.
+/// One method's part of a collection as the workers need it: the collection
+/// that holds the models (the collection itself, or a fused collection's
+/// member), its method's canonical parameters (what extract and codebook
+/// requests carry) and options, and its current codebook.
 struct CollectionInfo {
+  std::string name;
   v1::PipelineParams params;
   RetrievalPipelineOptions options;
-  std::string codebook_id;
+  std::string codebook_id;  // "<name>@<build job>" of the last build; empty before
 };
+
+/// A collection with everything that ranks it (CollectionOptions): its
+/// parts, one per method, and whether it ranks by its last build's
+/// RankingState (ranking.h).
+struct CollectionPlan {
+  std::string name;
+  v1::PipelineParams params;  // as stored: canonical
+  CollectionOptions options;
+  std::string codebook_id;  // "<name>@<build job>" of the last build; empty before
+  /// The collection itself (one method), or its members (fused), in method order.
+  std::vector<CollectionInfo> parts;
+  /// A member of a fused collection: built, ranked and listed through it.
+  bool member = false;
+
+  bool fused() const { return options.fused(); }
+  /// The build job of codebook_id ("" before the first build).
+  std::string build() const;
+  std::vector<std::string> PartNames() const;
+};
+
+/// A fused collection's member for `method`: "<fused>~<method>" ('~' is not
+/// a character of the names clients give).
+std::string MemberCollectionName(const std::string& fused, FeatureMethod method);
+/// Whether `name` is a fused collection's member.
+bool IsMemberCollection(const std::string& name);
 
 /// NotFound when absent; the parameters' validation error when they no
 /// longer validate.
+absl::StatusOr<CollectionPlan> LoadCollectionPlan(CoordinatorStore* store, const std::string& name);
+/// A collection of one method (or a member): its one part.
+/// FailedPrecondition for a fused collection.
 absl::StatusOr<CollectionInfo> LoadCollection(CoordinatorStore* store, const std::string& name);
 
 /// What the index ranks a model by: its histogram over a codebook (bag of

@@ -1,0 +1,289 @@
+#include "services/coordinator/ranking.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <tuple>
+
+#include "absl/strings/str_cat.h"
+#include "common/base/byte_order.h"
+#include "common/base/hash.h"
+#include "common/base/status_macros.h"
+#include "common/search/fusion.h"
+#include "common/search/rerank.h"
+
+namespace meshseek {
+namespace {
+
+constexpr char kMagic[4] = {'M', 'S', 'R', 'S'};
+constexpr uint32_t kVersion = 1;
+constexpr std::size_t kMaxText = 1 << 16;  // ids and labels are far shorter
+
+void PutText(const std::string& text, std::string* out) {
+  PutLittleEndian(text.size(), 4, out);
+  out->append(text);
+}
+
+// Reads little-endian fields from bytes, bounded: every read checks what is
+// left first.
+class Reader {
+ public:
+  explicit Reader(absl::string_view bytes) : bytes_(bytes) {}
+  bool Has(std::size_t n) const { return bytes_.size() - at_ >= n; }
+  bool Int(int width, uint64_t* v) {
+    if (!Has(width)) return false;
+    *v = GetLittleEndian(bytes_.data() + at_, width);
+    at_ += width;
+    return true;
+  }
+  bool Double(double* v) {
+    uint64_t bits;
+    if (!Int(8, &bits)) return false;
+    std::memcpy(v, &bits, sizeof(*v));
+    return true;
+  }
+  bool Text(std::string* text) {
+    uint64_t size;
+    if (!Int(4, &size) || size > kMaxText || !Has(size)) return false;
+    text->assign(bytes_.data() + at_, size);
+    at_ += size;
+    return true;
+  }
+  bool Bytes(std::size_t n, absl::string_view* out) {
+    if (!Has(n)) return false;
+    *out = bytes_.substr(at_, n);
+    at_ += n;
+    return true;
+  }
+  std::size_t left() const { return bytes_.size() - at_; }
+
+ private:
+  absl::string_view bytes_;
+  std::size_t at_ = 0;
+};
+
+}  // namespace
+
+std::string RankingState::Serialize() const {
+  std::string out(kMagic, sizeof(kMagic));
+  PutLittleEndian(kVersion, 4, &out);
+  PutLittleEndian(scales.size(), 4, &out);
+  for (double s : scales) {
+    uint64_t bits;
+    std::memcpy(&bits, &s, sizeof(bits));
+    PutLittleEndian(bits, 8, &out);
+  }
+  PutLittleEndian(model_ids.size(), 8, &out);
+  for (std::size_t i = 0; i < model_ids.size(); ++i) {
+    PutText(model_ids[i], &out);
+    PutLittleEndian(ordinals[i], 8, &out);
+    PutText(labels[i], &out);
+  }
+  out.push_back(graph.has_value() ? 1 : 0);
+  if (graph.has_value()) {
+    const std::string bytes = graph->Serialize();
+    PutLittleEndian(bytes.size(), 8, &out);
+    out.append(bytes);
+  }
+  PutLittleEndian(Fnv1a64(out), 8, &out);
+  return out;
+}
+
+absl::StatusOr<RankingState> RankingState::Parse(absl::string_view bytes) {
+  const auto bad = [](const auto&... what) {
+    return absl::DataLossError(absl::StrCat("ranking state: ", what...));
+  };
+  if (bytes.size() < sizeof(kMagic) + 8 ||
+      std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
+    return bad("not a ranking state (", bytes.size(), " bytes)");
+  }
+  const std::size_t body = bytes.size() - 8;
+  if (Fnv1a64(bytes.substr(0, body)) != GetLittleEndian(bytes.data() + body, 8)) {
+    return bad("checksum mismatch");
+  }
+  Reader in(bytes.substr(sizeof(kMagic), body - sizeof(kMagic)));
+  uint64_t version = 0, methods = 0, n = 0, has_graph = 0;
+  if (!in.Int(4, &version) || version != kVersion) return bad("unsupported version ", version);
+  if (!in.Int(4, &methods) || methods == 0 || methods > 64 || !in.Has(methods * 8)) {
+    return bad("bad method count ", methods);
+  }
+  RankingState state;
+  state.scales.resize(methods);
+  for (double& s : state.scales) {
+    if (!in.Double(&s) || !std::isfinite(s) || !(s > 0)) return bad("bad scale");
+  }
+  // Each model takes at least 16 bytes: bound n before allocating.
+  if (!in.Int(8, &n) || n > in.left() / 16) return bad("bad model count ", n);
+  state.model_ids.resize(n);
+  state.ordinals.resize(n);
+  state.labels.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!in.Text(&state.model_ids[i]) || !in.Int(8, &state.ordinals[i]) ||
+        !in.Text(&state.labels[i])) {
+      return bad("model ", i, " of ", n, " is cut short");
+    }
+  }
+  if (!in.Int(1, &has_graph) || has_graph > 1) return bad("bad graph flag");
+  if (has_graph == 1) {
+    uint64_t size = 0;
+    absl::string_view graph_bytes;
+    if (!in.Int(8, &size) || !in.Bytes(size, &graph_bytes)) return bad("graph cut short");
+    MESHSEEK_ASSIGN_OR_RETURN(NeighborGraph graph, NeighborGraph::Parse(graph_bytes));
+    if (graph.size() != n) return bad("a graph of ", graph.size(), " nodes for ", n, " models");
+    state.graph = std::move(graph);
+  }
+  if (in.left() != 0) return bad(in.left(), " bytes after the end");
+  return state;
+}
+
+absl::StatusOr<Ranking> Ranking::Make(std::string build,
+                                      RankingState state,
+                                      const CollectionOptions& options) {
+  if (state.scales.size() != options.methods.size()) {
+    return absl::DataLossError(absl::StrCat("ranking state of ", state.scales.size(),
+                                            " methods for ", options.MethodName()));
+  }
+  if (options.rerank.enabled() &&
+      (!state.graph.has_value() ||
+       static_cast<std::size_t>(state.graph->k()) <
+           std::min<std::size_t>(options.rerank.graph_k(), state.model_ids.size()))) {
+    return absl::DataLossError("ranking state without the neighbour graph re-ranking needs");
+  }
+  Ranking ranking;
+  ranking.build = std::move(build);
+  MESHSEEK_ASSIGN_OR_RETURN(ranking.factors, FusionFactors(options.weights, state.scales));
+  for (uint32_t i = 0; i < state.model_ids.size(); ++i) ranking.node_of[state.model_ids[i]] = i;
+  ranking.state = std::move(state);
+  return ranking;
+}
+
+absl::StatusOr<std::vector<float>> Ranking::RankRow(
+    const std::vector<absl::Span<const float>>& part_rows,
+    std::optional<uint32_t> self,
+    const CollectionOptions& options) const {
+  const std::size_t n = state.model_ids.size();
+  if (part_rows.size() != factors.size()) {
+    return absl::InternalError(
+        absl::StrCat(part_rows.size(), " rows for ", factors.size(), " methods"));
+  }
+  for (const absl::Span<const float>& row : part_rows) {
+    if (row.size() != n) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "a row of ", row.size(), " distances for the ", n, " models of build ", build,
+          "; build again"));
+    }
+  }
+  std::vector<float> fused(n);
+  FuseRows(part_rows, factors, absl::MakeSpan(fused));
+  if (!options.rerank.enabled()) return fused;
+  return RerankRow(*state.graph, fused, self, options.rerank);
+}
+
+absl::StatusOr<std::vector<v1::ScoredModel>> Ranking::Query(
+    const std::vector<std::vector<IndexShards::Scored>>& part_distances,
+    const CollectionOptions& options,
+    std::size_t top_k) const {
+  const std::size_t n = state.model_ids.size();
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<std::vector<float>> rows(part_distances.size(), std::vector<float>(n, inf));
+  std::vector<uint8_t> answered(n, 0);
+  for (std::size_t p = 0; p < part_distances.size(); ++p) {
+    for (const IndexShards::Scored& s : part_distances[p]) {
+      auto it = node_of.find(s.model_id);
+      if (it == node_of.end()) continue;  // ingested after the build
+      rows[p][it->second] = s.distance;
+      answered[it->second] += 1;
+    }
+  }
+  std::vector<absl::Span<const float>> spans(rows.begin(), rows.end());
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<float> ranked,
+                            RankRow(spans, std::nullopt, options));
+  std::vector<uint32_t> nodes;
+  for (uint32_t i = 0; i < n; ++i) {
+    if (answered[i] == part_distances.size()) nodes.push_back(i);  // removed ones are not
+  }
+  const auto before = [&](uint32_t a, uint32_t b) {
+    return std::make_tuple(ranked[a], state.ordinals[a], std::cref(state.model_ids[a])) <
+           std::make_tuple(ranked[b], state.ordinals[b], std::cref(state.model_ids[b]));
+  };
+  const std::size_t k = std::min(top_k, nodes.size());
+  std::partial_sort(nodes.begin(), nodes.begin() + k, nodes.end(), before);
+  std::vector<v1::ScoredModel> results(k);
+  for (std::size_t r = 0; r < k; ++r) {
+    const uint32_t i = nodes[r];
+    results[r].set_model_id(state.model_ids[i]);
+    results[r].set_label(state.labels[i]);
+    results[r].set_distance(ranked[i]);
+    results[r].set_ordinal(state.ordinals[i]);
+  }
+  return results;
+}
+
+std::vector<IndexShards::Part> IndexParts(const CollectionPlan& plan) {
+  std::vector<IndexShards::Part> parts;
+  for (const CollectionInfo& part : plan.parts) {
+    parts.push_back({part.name, part.options.kl.epsilon});
+  }
+  return parts;
+}
+
+absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index, const CollectionPlan& plan) {
+  const std::vector<IndexShards::Part> parts = IndexParts(plan);
+  const CollectionOptions& options = plan.options;
+  RankingState state;
+  // Pass 1: every model in order, and each method's scale over the sample
+  // rows (the rows come in the order ScaleSampleRows lists them).
+  std::vector<DistanceScale> scales(parts.size());
+  std::size_t n = 0;
+  {
+    // The models first: their number fixes the sample rows.
+    std::vector<std::size_t> first_row = {0};
+    MESHSEEK_RETURN_IF_ERROR(index->ForEachDistanceRow(
+        parts,
+        [&](const IndexShards::Row& row) -> absl::Status {
+          n = row.distances.front().size();
+          return absl::OkStatus();
+        },
+        &first_row));
+  }
+  std::vector<std::size_t> sample = ScaleSampleRows(n);
+  std::size_t seen = 0;
+  MESHSEEK_RETURN_IF_ERROR(index->ForEachDistanceRow(
+      parts,
+      [&](const IndexShards::Row& row) -> absl::Status {
+        for (std::size_t p = 0; p < parts.size(); ++p) scales[p].AddRow(sample[seen], row.distances[p]);
+        ++seen;
+        return absl::OkStatus();
+      },
+      &sample));
+  for (const DistanceScale& s : scales) state.scales.push_back(s.Scale());
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<double> factors,
+                            FusionFactors(options.weights, state.scales));
+  // Pass 2: the models, and the graph of the fused rows.
+  if (options.rerank.enabled()) {
+    MESHSEEK_ASSIGN_OR_RETURN(state.graph, NeighborGraph::Create(n, options.rerank.graph_k()));
+  }
+  std::vector<float> fused(n);
+  MESHSEEK_RETURN_IF_ERROR(index->ForEachDistanceRow(
+      parts, [&](const IndexShards::Row& row) -> absl::Status {
+        const std::size_t i = state.model_ids.size();
+        if (row.distances.front().size() != n || i >= n) {
+          return absl::AbortedError("the collection changed during its build; build again");
+        }
+        state.model_ids.push_back(row.model->model_id());
+        state.ordinals.push_back(row.model->ordinal());
+        state.labels.push_back(row.model->label());
+        if (state.graph.has_value()) {
+          FuseRows(row.distances, factors, absl::MakeSpan(fused));
+          state.graph->SetRow(static_cast<uint32_t>(i), fused);
+        }
+        return absl::OkStatus();
+      }));
+  if (state.model_ids.size() != n) {
+    return absl::AbortedError("the collection changed during its build; build again");
+  }
+  return state;
+}
+
+}  // namespace meshseek

@@ -1,0 +1,93 @@
+// How the services rank a rescaled collection (fused, or re-ranked: see
+// common/pipeline/collection_options.h), with the same arithmetic as the
+// in-process pipeline (CombineMethodDistances), so that Evaluate streams the
+// same matrix bit for bit.
+//
+// A build leaves a RankingState (stored by the coordinator, one per
+// collection): each method's distance scale, estimated over the sample rows
+// of fusion.h, the models of the build in node order (the first part's
+// (ordinal, id) order, which is ingest order) with their labels and
+// ordinals, and, when re-ranked, the neighbour graph of the fused distances.
+// Queries then need no more than each part's distances to every model:
+// fused with the stored scales and re-ranked against the stored graph, the
+// query joining it (rerank.h). Models ingested after the build are not in
+// the state and wait for the next build; a model removed since ranks nowhere.
+//
+// Cost of a build's ranking step: two passes over the parts' distances, the
+// sample rows then all rows (O(N^2) distances, in blocks of IndexShards'
+// kMatrixBatch rows), and a partial sort per row. Memory: the state is
+// about 12 bytes per neighbour (k1 + 1 per model) plus ids and labels.
+#ifndef MESHSEEK_SERVICES_COORDINATOR_RANKING_H_
+#define MESHSEEK_SERVICES_COORDINATOR_RANKING_H_
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/container/flat_hash_map.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "absl/types/span.h"
+#include "common/search/neighbor_graph.h"
+#include "meshseek/v1/types.pb.h"
+#include "services/coordinator/index_shards.h"
+#include "services/coordinator/workers.h"
+
+namespace meshseek {
+
+struct RankingState {
+  /// Each method's distance scale, in method order.
+  std::vector<double> scales;
+  /// The build's models in node order.
+  std::vector<std::string> model_ids;
+  std::vector<uint64_t> ordinals;
+  std::vector<std::string> labels;
+  /// The neighbour graph of the fused distances (re-ranked collections).
+  std::optional<NeighborGraph> graph;
+
+  /// "MSRS" | uint32 version (1) | uint32 methods | doubles | uint64 n |
+  /// per model (uint32 length, id, uint64 ordinal, uint32 length, label) |
+  /// uint8 graph present | [uint64 length, NeighborGraph bytes] | FNV-1a 64.
+  std::string Serialize() const;
+  /// DataLoss naming what is wrong for bytes that are not a state.
+  static absl::StatusOr<RankingState> Parse(absl::string_view bytes);
+};
+
+/// A parsed state ready for queries: node of each model id, fusion factors.
+struct Ranking {
+  std::string build;
+  RankingState state;
+  absl::flat_hash_map<std::string, uint32_t> node_of;
+  std::vector<double> factors;  // FusionFactors(weights, scales)
+
+  static absl::StatusOr<Ranking> Make(std::string build,
+                                      RankingState state,
+                                      const CollectionOptions& options);
+
+  /// The collection's distances from one row of each part's distances
+  /// (node order): fused, and re-ranked when the options say so; `self` is
+  /// the row's own node (Evaluate) or nullopt for a query.
+  absl::StatusOr<std::vector<float>> RankRow(const std::vector<absl::Span<const float>>& part_rows,
+                                             std::optional<uint32_t> self,
+                                             const CollectionOptions& options) const;
+
+  /// A query's top_k from each part's distances to every model (as the index
+  /// answered them): models of the build answered by every part, by
+  /// (distance, ordinal, id).
+  absl::StatusOr<std::vector<v1::ScoredModel>> Query(
+      const std::vector<std::vector<IndexShards::Scored>>& part_distances,
+      const CollectionOptions& options,
+      std::size_t top_k) const;
+};
+
+/// The state of `plan` after a build indexed every part: scales over the
+/// sample rows, then the graph of every fused row (re-ranked collections).
+absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index, const CollectionPlan& plan);
+
+/// The parts of `plan` as IndexShards parts.
+std::vector<IndexShards::Part> IndexParts(const CollectionPlan& plan);
+
+}  // namespace meshseek
+
+#endif  // MESHSEEK_SERVICES_COORDINATOR_RANKING_H_
