@@ -1,10 +1,10 @@
 // Fusion and re-ranking choices on a labelled collection, from the distance
 // matrices each method's `meshseek eval` wrote (bench/results/fusion.txt):
 //
-//   fusion_sweep --manifest SET/manifest.csv \
-//     --matrices bfdsift=out/bf/distances.bin,rld=out/rld/distances.bin,... \
-//     --combos bfdsift+rld,bfdsift+rld+lfd [--weights "1,1;2,1"] \
-//     [--normalisations scale,query_mean,query_z,query_knn] \
+//   fusion_sweep --manifest SET/manifest.csv
+//     --matrices bfdsift=out/bf/distances.bin,rld=out/rld/distances.bin,...
+//     --combos bfdsift+rld,bfdsift+rld+lfd [--weights "1,1;2,1"]
+//     [--normalisations scale,query_mean,query_z,query_knn]
 //     [--k1 10,20 --k2 1,4 --lambda 0.1,0.3 --depth 100] [--csv OUT] [--tag TEXT]
 //
 // Every combination of the lists is one row: the methods, their weights (a
@@ -14,7 +14,9 @@
 // by its mean over the collection); the query_* normalisations divide each
 // row by its own mean, standardise it, or divide by the mean of its 10
 // nearest, for comparison. Metrics as metrics.json computes them.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -26,6 +28,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_replace.h"
 #include "absl/strings/str_split.h"
 #include "common/eval/distance_matrix.h"
 #include "common/eval/manifest.h"
@@ -44,6 +47,11 @@ ABSL_FLAG(std::string, k1, "20", "re-ranking k1 values");
 ABSL_FLAG(std::string, k2, "4", "re-ranking k2 values");
 ABSL_FLAG(std::string, lambda, "0.1", "re-ranking lambda values");
 ABSL_FLAG(std::string, depth, "200", "re-ranking depth values");
+ABSL_FLAG(std::string,
+          manifold,
+          "",
+          "experimental second re-ranking, manifold ranking on the k-NN graph: k:alpha pairs, "
+          "comma-separated (e.g. 10:0.9,20:0.95), each with every --lambda");
 ABSL_FLAG(bool, rerank_only, false, "skip the rows without re-ranking");
 ABSL_FLAG(std::string, csv, "", "append rows to this CSV file");
 ABSL_FLAG(std::string, tag, "", "free text copied into the rows");
@@ -102,6 +110,70 @@ std::vector<float> QueryNormalised(const std::vector<float>& d, std::size_t n,
       out[i * n + j] = out[j * n + i] = s;
     }
     out[i * n + i] = how == "query_z" ? -1e30f : 0.0f;
+  }
+  return out;
+}
+
+// Manifold ranking (Zhou, Weston, Gretton, Bousquet & Schoelkopf, NIPS
+// 2003), the diffusion alternative to k-reciprocal re-ranking, over the
+// symmetric k-NN graph of the fused distances d: W_ij = exp(-d_ij^2 /
+// (s_i s_j)) on the graph's edges (s_i: i's distance to its k-th neighbour,
+// local scaling), S = D^-1/2 W D^-1/2, scores F = (1 - alpha)(I - alpha
+// S)^-1, computed by iterating F <- alpha S F + (1 - alpha) I. A query's
+// distance to j is (1 - lambda)(1 - F_qj / max_j F_qj) + lambda d_qj.
+// Dense N x N: for the development sets only (meshseek ships k-reciprocal).
+std::vector<float> ManifoldRanked(const std::vector<float>& d, std::size_t n, int k, double alpha,
+                                  double lambda) {
+  const NeighborGraph graph = *NeighborGraph::FromMatrix(d, n, k + 1);
+  std::vector<double> sigma(n, 1.0);
+  std::vector<std::map<uint32_t, double>> w(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto list = graph.Of(static_cast<uint32_t>(i));
+    if (!list.empty()) sigma[i] = std::max<double>(list.back().distance, 1e-12);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    for (const auto& nb : graph.Of(static_cast<uint32_t>(i))) {
+      const std::size_t j = nb.node;
+      if (j == i || !std::isfinite(nb.distance)) continue;
+      const double x = std::exp(-double(nb.distance) * nb.distance / (sigma[i] * sigma[j]));
+      w[i][j] = x;
+      w[j][i] = x;
+    }
+  }
+  std::vector<double> degree(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (const auto& [j, x] : w[i]) degree[i] += x;
+  }
+  std::vector<std::vector<std::pair<uint32_t, double>>> s(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (const auto& [j, x] : w[i]) {
+      s[i].emplace_back(j, x / std::sqrt(std::max(degree[i] * degree[j], 1e-300)));
+    }
+  }
+  std::vector<double> f(n * n, 0.0), next(n * n);
+  for (std::size_t i = 0; i < n; ++i) f[i * n + i] = 1 - alpha;
+  const int iterations = static_cast<int>(std::ceil(std::log(1e-4) / std::log(alpha)));
+  for (int t = 0; t < iterations; ++t) {
+    for (std::size_t i = 0; i < n; ++i) {
+      double* row = &next[i * n];
+      std::fill(row, row + n, 0.0);
+      row[i] = 1 - alpha;
+      for (const auto& [j, x] : s[i]) {
+        const double* src = &f[j * n];
+        for (std::size_t c = 0; c < n; ++c) row[c] += alpha * x * src[c];
+      }
+    }
+    f.swap(next);
+  }
+  std::vector<float> out(n * n);
+  for (std::size_t q = 0; q < n; ++q) {
+    double top = 0;
+    for (std::size_t j = 0; j < n; ++j) top = std::max(top, f[q * n + j]);
+    for (std::size_t j = 0; j < n; ++j) {
+      const double diffusion = top > 0 ? 1 - f[q * n + j] / top : 1;
+      out[q * n + j] = q == j ? 0.0f
+                              : static_cast<float>((1 - lambda) * diffusion + lambda * d[q * n + j]);
+    }
   }
   return out;
 }
@@ -235,6 +307,40 @@ int main(int argc, char** argv) {
           std::fflush(stdout);
           if (!absl::GetFlag(FLAGS_csv).empty()) {
             std::ofstream(absl::GetFlag(FLAGS_csv), std::ios::app) << row << "\n";
+          }
+        }
+        if (how != "scale") continue;
+        for (absl::string_view pair :
+             absl::StrSplit(absl::GetFlag(FLAGS_manifold), ',', absl::SkipEmpty())) {
+          const std::vector<double> ka = Numbers(absl::StrReplaceAll(pair, {{":", ","}}));
+          if (ka.size() != 2) continue;
+          for (double lambda : Numbers(absl::GetFlag(FLAGS_lambda))) {
+            const auto start = std::chrono::steady_clock::now();
+            CollectionOptions options = CollectionOptions::ForMethods(methods);
+            options.SetRunOptions(absl::GetFlag(FLAGS_threads), false);
+            options.weights = weights;
+            options.rerank.method = RerankOptions::Method::kNone;
+            std::vector<double> scales;
+            auto fused = CombineMethodDistances(parts, n, options, &scales);
+            if (!fused.ok()) return 1;
+            const std::vector<float> ranked =
+                ManifoldRanked(*fused, n, static_cast<int>(ka[0]), ka[1], lambda);
+            auto metrics = EvaluateRetrieval(labels, ranked, absl::GetFlag(FLAGS_threads));
+            const double seconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            std::vector<std::string> w;
+            for (double x : weights) w.push_back(absl::StrFormat("%g", x));
+            const std::string row = absl::StrFormat(
+                "%s,%s,%s,%s,manifold,%g,%g,%g,0,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f",
+                absl::GetFlag(FLAGS_tag), combo, absl::StrJoin(w, ":"), how, ka[0], ka[1], lambda,
+                100 * metrics->micro.nn, 100 * metrics->micro.rp_excl,
+                100 * metrics->micro.second_tier, 100 * metrics->micro.e_measure,
+                100 * metrics->micro.dcg, 100 * metrics->macro.rp_excl, seconds);
+            std::printf("%s\n", row.c_str());
+            std::fflush(stdout);
+            if (!absl::GetFlag(FLAGS_csv).empty()) {
+              std::ofstream(absl::GetFlag(FLAGS_csv), std::ios::app) << row << "\n";
+            }
           }
         }
       }

@@ -47,7 +47,10 @@ ABSL_FLAG(std::string,
           features_cache,
           "",
           "read the features from this file if it exists, else extract and write them there");
-ABSL_FLAG(std::string, weightings, "none", "experimental: comma-separated none|idf|pow0.5|idfpow0.5");
+ABSL_FLAG(std::string,
+          weightings,
+          "none",
+          "comma-separated histogram weightings none|idf|pow0.5|idfpow0.5 (histogram_weighting.h)");
 ABSL_FLAG(std::string, distances, "kl", "experimental: comma-separated kl|l1|l2|hell");
 ABSL_FLAG(std::string,
           keep_levels,
@@ -114,33 +117,14 @@ bool ReadFeatures(const std::string& path, std::vector<meshseek::LocalFeatures>*
   return true;
 }
 
-// Experimental histogram weighting (before the shipped one exists): "idf"
-// multiplies bin k by ln(N / df_k), "pow<a>" raises bins to a, "idfpow<a>"
-// both; results renormalised to sum 1.
-void WeightHistograms(const std::string& mode, std::vector<std::vector<float>>* hs) {
-  if (mode.empty() || mode == "none") return;
-  const std::size_t n = hs->size(), v = (*hs)[0].size();
-  std::vector<double> idf(v, 1.0);
-  bool use_idf = mode.rfind("idf", 0) == 0;
-  double power = 1.0;
+// A --weightings entry as the shipped HistogramWeighting: "none", "idf",
+// "pow<a>" (power a), "idfpow<a>" (both).
+meshseek::HistogramWeighting ParseWeighting(const std::string& mode) {
+  meshseek::HistogramWeighting w;
+  w.idf = mode.rfind("idf", 0) == 0;
   const std::size_t at = mode.find("pow");
-  if (at != std::string::npos) power = std::stod(mode.substr(at + 3));
-  if (use_idf) {
-    std::vector<int> df(v, 0);
-    for (const auto& h : *hs)
-      for (std::size_t k = 0; k < h.size(); ++k) df[k] += h[k] > 0;
-    for (std::size_t k = 0; k < v; ++k) idf[k] = df[k] ? std::log(double(n) / df[k]) + 1e-3 : 0;
-  }
-  for (auto& h : *hs) {
-    double sum = 0;
-    for (std::size_t k = 0; k < h.size(); ++k) {
-      if (h[k] <= 0) continue;
-      h[k] = static_cast<float>(std::pow(h[k] * idf[k], power));
-      sum += h[k];
-    }
-    if (sum > 0)
-      for (float& x : h) x = static_cast<float>(x / sum);
-  }
+  if (at != std::string::npos) w.power = std::stod(mode.substr(at + 3));
+  return w;
 }
 
 // Experimental distances on dense histograms: "l1", "l2" (of L2-normalised
@@ -264,12 +248,17 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", codebook.status().ToString().c_str());
         return 1;
       }
+      options.weighting = {};  // each --weightings entry below
       const auto encoded = EncodeCollection(*codebook, *features, options);
       for (absl::string_view weighting : absl::StrSplit(absl::GetFlag(FLAGS_weightings), ',')) {
       for (absl::string_view distance : absl::StrSplit(absl::GetFlag(FLAGS_distances), ',')) {
       for (double eps : distance == "kl" ? epsilons : std::vector<double>{0}) {
         std::vector<std::vector<float>> histograms = *encoded;
-        WeightHistograms(std::string(weighting), &histograms);
+        if (absl::Status s = WeightCollection(ParseWeighting(std::string(weighting)), &histograms);
+            !s.ok()) {
+          std::fprintf(stderr, "%s\n", s.ToString().c_str());
+          return 1;
+        }
         std::vector<float> matrix;
         if (distance == "kl") {
           options.kl.epsilon = eps;

@@ -650,6 +650,7 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
   v1::PipelineParams params;
   for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
            {"method", "lsf+lfd"}, {"points", "128"}, {"vocabulary", "64"}, {"view_size", "64"},
+           {"histogram_power", "0.5"},  // LSF's histograms square-rooted, in the coordinator
            {"rerank_k1", "5"}, {"rerank_k2", "2"}, {"rerank_depth", "20"}}) {
     v1::ParamValue* v = params.add_values();
     v->set_name(name);
@@ -669,6 +670,17 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
   ASSERT_TRUE(stack.WaitServing());
   auto stub = stack.Coordinator();
   ASSERT_TRUE(CreateCollection(stub.get(), "fused", params).ok());
+  {
+    // idf needs document frequencies over the whole collection, which the
+    // services do not keep: refused by name rather than served unweighted.
+    v1::PipelineParams with_idf = params;
+    v1::ParamValue* idf = with_idf.add_values();
+    idf->set_name("idf");
+    idf->set_value("true");
+    const absl::Status refused = CreateCollection(stub.get(), "with-idf", with_idf);
+    EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(std::string(refused.message()), HasSubstr("idf=true"));
+  }
   std::set<std::string> jobs;
   ASSERT_EQ(Ingest(stub.get(), "fused", 0, n, &jobs), n);
   for (const std::string& job : jobs) {

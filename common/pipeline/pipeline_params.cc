@@ -461,6 +461,22 @@ std::vector<ParamSpec> MakeSpecs() {
       bag,
       {},
       +[](Options& o) -> uint64_t& { return o.kmeans.seed; }));
+  specs.push_back(Field<bool>(
+      "idf",
+      "weight histogram words by inverse document frequency over the collection (tf-idf)",
+      0,
+      1,
+      bag,
+      {},
+      +[](Options& o) -> bool& { return o.weighting.idf; }));
+  specs.push_back(Field<double>(
+      "histogram_power",
+      "raise histogram bins to this power before ranking (0.5: square root; 1: none)",
+      0.01,
+      1,
+      bag,
+      {},
+      +[](Options& o) -> double& { return o.weighting.power; }));
   specs.push_back(Field<double>(
       "kl_epsilon",
       "mass added to every histogram bin before KL divergence (zero-bin rule)",
@@ -822,10 +838,14 @@ std::string PipelineParamsUsage() {
       const std::string one = spec.collection_get(CollectionOptions());
       const std::string several = spec.collection_get(
           CollectionOptions::ForMethods({FeatureMethod::kBfDsift, FeatureMethod::kRldSift}));
-      const std::string value =
-          spec.name == "weights" ? "1 for each method"
-          : one == several       ? one
-                                 : absl::StrCat("one method ", one, ", several ", several);
+      std::string value = one == several ? one : absl::StrCat("one method ", one, ", several ", several);
+      if (spec.name == "weights") {
+        std::vector<std::string> own;
+        for (const FeatureMethodInfo& m : FeatureMethods()) {
+          own.push_back(absl::StrCat(m.name, " ", m.fusion_weight));
+        }
+        value = absl::StrCat("each method's own: ", absl::StrJoin(own, ", "));
+      }
       absl::StrAppend(&usage, "  --", spec.name, "  ", spec.TypeDescription(), "; ", spec.doc,
                       "\n      the collection; default: ", value, "\n");
       continue;

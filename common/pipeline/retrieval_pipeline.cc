@@ -53,6 +53,7 @@ RetrievalPipelineOptions RetrievalPipelineOptions::ForMethod(FeatureMethod metho
 absl::Status RetrievalPipelineOptions::Validate() const {
   MESHSEEK_RETURN_IF_ERROR(extractor.Validate());
   MESHSEEK_RETURN_IF_ERROR(kmeans.Validate());
+  MESHSEEK_RETURN_IF_ERROR(weighting.Validate());
   // Histograms of a larger vocabulary would be refused by the index
   // (SparseHistogram::Validate) only after the whole codebook was learnt.
   if (kmeans.num_centroids > static_cast<int64_t>(kMaxVocabulary)) {
@@ -157,6 +158,7 @@ absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
       return absl::Status(errors[i].code(), absl::StrCat("model ", i, ": ", errors[i].message()));
     }
   }
+  MESHSEEK_RETURN_IF_ERROR(WeightCollection(options.weighting, &histograms));
   return histograms;
 }
 

@@ -18,6 +18,7 @@
 #include "absl/status/statusor.h"
 #include "common/base/json.h"
 #include "common/bof/codebook.h"
+#include "common/bof/histogram_weighting.h"
 #include "common/bof/kl_divergence.h"
 #include "common/bof/kmeans.h"
 #include "common/eval/manifest.h"
@@ -39,6 +40,8 @@ struct RetrievalPipelineOptions {
   /// defaults (V = 2,000, k-means on 100 sampled features per word) were
   /// chosen on the development sets (README, bench/results).
   KMeansOptions kmeans;
+  /// Histogram weighting before ranking (idf, power); off by default.
+  HistogramWeighting weighting;
   /// Ranking: symmetric KL divergence and its zero-bin rule.
   KlDivergenceOptions kl;
   /// Threads (<= 0: all cores). Extraction runs one model per thread; k-means,
@@ -65,8 +68,9 @@ absl::StatusOr<std::vector<LocalFeatures>> ExtractCollection(
 absl::StatusOr<Codebook> TrainCollectionCodebook(const std::vector<LocalFeatures>& features,
                                                  const RetrievalPipelineOptions& options);
 
-// One normalised histogram per model; an empty one for a model without local
-// features (LD-SIFT and RLD-SIFT may detect nothing on a model).
+// One normalised histogram per model, weighted as options.weighting says (idf
+// over these histograms); an empty one for a model without local features
+// (LD-SIFT and RLD-SIFT may detect nothing on a model).
 absl::StatusOr<std::vector<std::vector<float>>> EncodeCollection(
     const Codebook& codebook,
     const std::vector<LocalFeatures>& features,

@@ -15,12 +15,17 @@
 //   d*(q, c)  = (1 - lambda) d_J(q, c) + lambda d(q, c).
 // Zhong et al.'s second expansion of R (adding the half-size sets of its
 // members) needs distances between models two hops apart, which the graph
-// does not keep; it is left out (k-reciprocal alone measured as well on the
-// development sets: bench/results/rerank.txt).
+// does not keep; it is left out. Manifold ranking (diffusion over the whole
+// graph, bench/fusion_sweep --manifold) was measured beside it: first tier
+// +0.4 on McGill, -0.1 on PSB train, better NN and DCG, but a query joining
+// the graph then costs iterations over every edge of the collection
+// (bench/results/fusion.txt); k-reciprocal's cost stays bounded.
 //
 // Cost. A query's re-ranking reads only the graph lists of its `depth`
 // nearest candidates, their k2 nearest and those lists' members: about
-// depth * k2 * (k1 + 1)^2 list entries, independent of the collection size.
+// depth * k2 * (k1 + 1)^2 list entries, independent of the collection size
+// (bench/results/rerank.txt: one query joining 100,000 models, every row of
+// PSB train).
 // Candidates beyond `depth` share no reciprocal neighbour worth finding and
 // keep d_J = 1, so every model keeps a distance and one order:
 // d* = (1 - lambda) + lambda d for them, above every re-ranked candidate's

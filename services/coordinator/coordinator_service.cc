@@ -104,6 +104,15 @@ grpc::Status CoordinatorService::CreateCollection(grpc::ServerContext*,
   if (!valid.ok()) {
     return rpc::ToGrpcStatus(Prefixed(valid.status(), absl::StrCat("collection '", request->name(), "': ")));
   }
+  for (const RetrievalPipelineOptions& method : valid->methods) {
+    if (method.weighting.idf) {
+      return grpc::Status(
+          grpc::StatusCode::INVALID_ARGUMENT,
+          absl::StrCat("collection '", request->name(), "': idf=true needs the whole "
+                       "collection's document frequencies, which the services do not keep; "
+                       "evaluate it in process (meshseek eval --server in-process)"));
+    }
+  }
   // Stored canonical: every parameter with its value, so the collection
   // keeps its meaning when a default changes, and creating it again with the
   // same parameters however written is not a conflict.

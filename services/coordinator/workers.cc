@@ -1,6 +1,7 @@
 #include "services/coordinator/workers.h"
 
 #include "absl/strings/str_cat.h"
+#include "common/bof/histogram_weighting.h"
 #include "common/base/status_macros.h"
 #include "common/rpc/convert.h"
 
@@ -134,6 +135,18 @@ absl::StatusOr<IndexSignature> Workers::Encode(const CollectionInfo& collection,
   MESHSEEK_RETURN_IF_ERROR(rpc::CallWithRetry(codebook_.get(), &v1::Codebook::Stub::Encode, request,
                                               &response, options_.call_deadline, retry_, stop_));
   signature.histogram = std::move(*response.mutable_histogram());
+  // Power normalisation needs nothing but the histogram: its non-zero bins in
+  // order, as the in-process pipeline weights the dense one (same values,
+  // same sum). idf collections are refused at creation.
+  const HistogramWeighting& weighting = collection.options.weighting;
+  if (weighting.idf) {
+    return absl::FailedPreconditionError("idf weighting is not served (collection refused)");
+  }
+  if (weighting.enabled()) {
+    MESHSEEK_RETURN_IF_ERROR(WeightHistogram(
+        weighting, {}, absl::MakeSpan(signature.histogram.mutable_weights()->mutable_data(),
+                                      signature.histogram.weights_size())));
+  }
   return signature;
 }
 
