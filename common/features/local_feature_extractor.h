@@ -51,6 +51,10 @@ struct FeatureMethodInfo {
   /// 2 for the methods strongest on the development sets (BF-DSIFT, RLD-SIFT),
   /// 1 for the others (bench/results/fusion.txt).
   double fusion_weight;
+  /// Its histograms' default power (HistogramWeighting::power): 0.5 (square
+  /// root) for LSF, +0.8 / +1.1 first tier on McGill / PSB train under KL;
+  /// 1 for the others, which it did not help (bench/results/weighting.txt).
+  double histogram_power;
   /// Validates the method's options in ExtractorOptions.
   absl::Status (*validate)(const ExtractorOptions& options);
   /// Extracts one mesh's features (see ExtractLocalFeatures).

@@ -46,6 +46,7 @@ RetrievalPipelineOptions RetrievalPipelineOptions::ForMethod(FeatureMethod metho
     options.kmeans.num_centroids = FeatureMethodInfoOf(method).vocabulary;
     options.kmeans.max_points_per_centroid =
         FeatureMethodInfoOf(method).kmeans_points_per_centroid;
+    options.weighting.power = FeatureMethodInfoOf(method).histogram_power;
   }
   return options;
 }
