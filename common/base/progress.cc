@@ -31,6 +31,11 @@ void ProgressBar::Advance(std::size_t n) {
   std::lock_guard<std::mutex> lock(mu_);
   done_ += n;
   const auto now = std::chrono::steady_clock::now();
+  if (!advanced_) {
+    advanced_ = true;
+    rate_base_done_ = done_;
+    rate_base_ = now;
+  }
   if (tty_) {
     if (now - last_draw_ >= std::chrono::milliseconds(100) || done_ == total_) {
       last_draw_ = now;
@@ -54,9 +59,15 @@ void ProgressBar::Finish() {
 }
 
 void ProgressBar::Draw(bool final_line) {
-  const double elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  const double rate = elapsed > 0 ? done_ / elapsed : 0.0;
+  const auto now = std::chrono::steady_clock::now();
+  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  const double since_base = std::chrono::duration<double>(now - rate_base_).count();
+  // Items per second since the first Advance (0 until a second one); the
+  // final line falls back to the whole run's when everything came at once.
+  double rate = advanced_ && done_ > rate_base_done_ && since_base > 0
+                    ? (done_ - rate_base_done_) / since_base
+                    : 0.0;
+  if (final_line && rate == 0.0 && elapsed > 0) rate = done_ / elapsed;
   std::string line;
   if (final_line) {
     line = absl::StrFormat(

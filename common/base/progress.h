@@ -38,6 +38,12 @@ class ProgressBar {
   bool tty_;
   bool finished_ = false;
   std::size_t done_ = 0;
+  // The rate counts from the first Advance on: a first jump (work found
+  // already done, e.g. a resumed ingest) would otherwise read as millions
+  // per second for the rest of the run.
+  bool advanced_ = false;
+  std::size_t rate_base_done_ = 0;
+  std::chrono::steady_clock::time_point rate_base_;
   int last_decile_ = -1;
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_draw_;

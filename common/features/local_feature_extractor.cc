@@ -100,7 +100,7 @@ const std::vector<FeatureMethodInfo>& FeatureMethods() {
        DescriptorKind::kBagOfFeatures,
        2000,
        100,
-       1,
+       1.5,
        0.5,
        [](const ExtractorOptions& o) { return o.lsf.Validate(); },
        ExtractLocalStatistics},

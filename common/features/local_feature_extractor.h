@@ -49,7 +49,8 @@ struct FeatureMethodInfo {
   int kmeans_points_per_centroid;
   /// Its default weight in a fused collection (CollectionOptions::weights):
   /// 2 for the methods strongest on the development sets (BF-DSIFT, RLD-SIFT),
-  /// 1 for the others (bench/results/fusion.txt).
+  /// 1.5 for LSF (with its square-rooted histograms), 1 for the others
+  /// (bench/results/fusion.txt).
   double fusion_weight;
   /// Its histograms' default power (HistogramWeighting::power): 0.5 (square
   /// root) for LSF, +0.8 / +1.1 first tier on McGill / PSB train under KL;

@@ -121,7 +121,9 @@ TEST(PipelineParamsTest, OneMethodRanksAloneAndSeveralAreFusedAndReranked) {
   const auto fused = CollectionOptionsFromValues({{"method", "bfdsift+rld+lsf+lfd"}});
   ASSERT_TRUE(fused.ok()) << fused.status();
   EXPECT_EQ(fused->MethodName(), "bfdsift+rld+lsf+lfd");
-  EXPECT_EQ(fused->weights, (std::vector<double>{2, 2, 1, 1}));  // the strongest count double
+  // The strongest count double, LSF one and a half (bench/results/fusion.txt).
+  EXPECT_EQ(fused->weights, (std::vector<double>{2, 2, 1.5, 1}));
+  EXPECT_EQ(fused->methods[2].weighting.power, 0.5);  // LSF's square roots
   EXPECT_EQ(fused->rerank.method, RerankOptions::Method::kKReciprocal);
   EXPECT_EQ(fused->methods[0].kmeans.num_centroids, 40000);  // each method its own defaults
   EXPECT_EQ(fused->methods[1].kmeans.num_centroids, 2000);

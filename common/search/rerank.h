@@ -16,10 +16,11 @@
 // Zhong et al.'s second expansion of R (adding the half-size sets of its
 // members) needs distances between models two hops apart, which the graph
 // does not keep; it is left out. Manifold ranking (diffusion over the whole
-// graph, bench/fusion_sweep --manifold) was measured beside it: first tier
-// +0.4 on McGill, -0.1 on PSB train, better NN and DCG, but a query joining
-// the graph then costs iterations over every edge of the collection
-// (bench/results/fusion.txt); k-reciprocal's cost stays bounded.
+// graph, bench/fusion_sweep --manifold) was measured beside it on the
+// default fusion: first tier equal on McGill, 0.7 lower on PSB train, better
+// second tier and DCG, but a query joining the graph then costs iterations
+// over every edge of the collection (bench/results/fusion.txt);
+// k-reciprocal's cost stays bounded.
 //
 // Cost. A query's re-ranking reads only the graph lists of its `depth`
 // nearest candidates, their k2 nearest and those lists' members: about
