@@ -3,12 +3,12 @@
 # of every method on McGill articulated and PSB train through the embedded
 # services (fresh data folder each), each matrix cross-checked with the
 # independent evaluator ../shared/tools/psb_eval.py.
-#   bench/accuracy.sh [DATA_DIR] [METHODS]   (defaults: ~/.cache/meshseek-data, "dld rld ld bfdsift lsf lfd")
+#   bench/accuracy.sh [DATA_DIR] [METHODS]   (defaults: ~/.cache/meshseek-data, "dld rld ld bfdsift lsf lfd bfdsift+rld+lsf+lfd")
 # Writes bench/results/accuracy.txt. Needs a Release build in ./build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA=${1:-$HOME/.cache/meshseek-data}
-METHODS=${2:-dld rld ld bfdsift lsf lfd}
+METHODS=${2:-dld rld ld bfdsift lsf lfd bfdsift+rld+lsf+lfd}
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
 RESULT=bench/results/accuracy.txt

@@ -76,7 +76,8 @@ std::vector<double> Numbers(absl::string_view text) {
 
 // Each row divided by (or standardised with) its own statistics over the
 // other models, then symmetrised.
-std::vector<float> QueryNormalised(const std::vector<float>& d, std::size_t n,
+std::vector<float> QueryNormalised(const std::vector<float>& d,
+                                   std::size_t n,
                                    const std::string& how) {
   std::vector<float> out(n * n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -122,8 +123,8 @@ std::vector<float> QueryNormalised(const std::vector<float>& d, std::size_t n,
 // S)^-1, computed by iterating F <- alpha S F + (1 - alpha) I. A query's
 // distance to j is (1 - lambda)(1 - F_qj / max_j F_qj) + lambda d_qj.
 // Dense N x N: for the development sets only (meshseek ships k-reciprocal).
-std::vector<float> ManifoldRanked(const std::vector<float>& d, std::size_t n, int k, double alpha,
-                                  double lambda) {
+std::vector<float> ManifoldRanked(
+    const std::vector<float>& d, std::size_t n, int k, double alpha, double lambda) {
   const NeighborGraph graph = *NeighborGraph::FromMatrix(d, n, k + 1);
   std::vector<double> sigma(n, 1.0);
   std::vector<std::map<uint32_t, double>> w(n);
@@ -171,8 +172,8 @@ std::vector<float> ManifoldRanked(const std::vector<float>& d, std::size_t n, in
     for (std::size_t j = 0; j < n; ++j) top = std::max(top, f[q * n + j]);
     for (std::size_t j = 0; j < n; ++j) {
       const double diffusion = top > 0 ? 1 - f[q * n + j] / top : 1;
-      out[q * n + j] = q == j ? 0.0f
-                              : static_cast<float>((1 - lambda) * diffusion + lambda * d[q * n + j]);
+      out[q * n + j] =
+          q == j ? 0.0f : static_cast<float>((1 - lambda) * diffusion + lambda * d[q * n + j]);
     }
   }
   return out;
@@ -193,7 +194,8 @@ int main(int argc, char** argv) {
 
   std::map<std::string, std::vector<float>> matrices;
   std::vector<std::string> given;
-  for (absl::string_view item : absl::StrSplit(absl::GetFlag(FLAGS_matrices), ',', absl::SkipEmpty())) {
+  for (absl::string_view item :
+       absl::StrSplit(absl::GetFlag(FLAGS_matrices), ',', absl::SkipEmpty())) {
     std::pair<std::string, std::string> kv = absl::StrSplit(item, absl::MaxSplits('=', 1));
     auto matrix = ReadDistanceMatrix(kv.second, n);
     if (!matrix.ok()) {
@@ -209,8 +211,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> weight_lists =
       absl::StrSplit(absl::GetFlag(FLAGS_weights), ';', absl::SkipEmpty());
 
-  std::printf("tag,methods,weights,normalisation,rerank,k1,k2,lambda,depth,NN,FT,ST,E,DCG,"
-              "FT_macro,seconds\n");
+  std::printf(
+      "tag,methods,weights,normalisation,rerank,k1,k2,lambda,depth,NN,FT,ST,E,DCG,"
+      "FT_macro,seconds\n");
   for (const std::string& combo : combos) {
     const std::vector<std::string> names = absl::StrSplit(combo, '+');
     std::vector<FeatureMethod> methods;
@@ -296,13 +299,24 @@ int main(int argc, char** argv) {
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
           std::vector<std::string> w;
           for (double x : weights) w.push_back(absl::StrFormat("%g", x));
-          const std::string row = absl::StrFormat(
-              "%s,%s,%s,%s,%s,%d,%d,%g,%d,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f",
-              absl::GetFlag(FLAGS_tag), combo, absl::StrJoin(w, ":"), how,
-              rerank.enabled() ? "kreciprocal" : "none", rerank.k1, rerank.k2, rerank.lambda,
-              rerank.depth, 100 * metrics->micro.nn, 100 * metrics->micro.rp_excl,
-              100 * metrics->micro.second_tier, 100 * metrics->micro.e_measure,
-              100 * metrics->micro.dcg, 100 * metrics->macro.rp_excl, seconds);
+          const std::string row =
+              absl::StrFormat("%s,%s,%s,%s,%s,%d,%d,%g,%d,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f",
+                              absl::GetFlag(FLAGS_tag),
+                              combo,
+                              absl::StrJoin(w, ":"),
+                              how,
+                              rerank.enabled() ? "kreciprocal" : "none",
+                              rerank.k1,
+                              rerank.k2,
+                              rerank.lambda,
+                              rerank.depth,
+                              100 * metrics->micro.nn,
+                              100 * metrics->micro.rp_excl,
+                              100 * metrics->micro.second_tier,
+                              100 * metrics->micro.e_measure,
+                              100 * metrics->micro.dcg,
+                              100 * metrics->macro.rp_excl,
+                              seconds);
           std::printf("%s\n", row.c_str());
           std::fflush(stdout);
           if (!absl::GetFlag(FLAGS_csv).empty()) {
@@ -332,10 +346,20 @@ int main(int argc, char** argv) {
             for (double x : weights) w.push_back(absl::StrFormat("%g", x));
             const std::string row = absl::StrFormat(
                 "%s,%s,%s,%s,manifold,%g,%g,%g,0,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f",
-                absl::GetFlag(FLAGS_tag), combo, absl::StrJoin(w, ":"), how, ka[0], ka[1], lambda,
-                100 * metrics->micro.nn, 100 * metrics->micro.rp_excl,
-                100 * metrics->micro.second_tier, 100 * metrics->micro.e_measure,
-                100 * metrics->micro.dcg, 100 * metrics->macro.rp_excl, seconds);
+                absl::GetFlag(FLAGS_tag),
+                combo,
+                absl::StrJoin(w, ":"),
+                how,
+                ka[0],
+                ka[1],
+                lambda,
+                100 * metrics->micro.nn,
+                100 * metrics->micro.rp_excl,
+                100 * metrics->micro.second_tier,
+                100 * metrics->micro.e_measure,
+                100 * metrics->micro.dcg,
+                100 * metrics->macro.rp_excl,
+                seconds);
             std::printf("%s\n", row.c_str());
             std::fflush(stdout);
             if (!absl::GetFlag(FLAGS_csv).empty()) {

@@ -22,9 +22,9 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "common/eval/retrieval_metrics.h"
 #include "common/features/lsf.h"
 #include "common/geometry/mesh_io.h"
-#include "common/eval/retrieval_metrics.h"
 #include "common/pipeline/retrieval_pipeline.h"
 
 ABSL_FLAG(std::string, manifest, "", "CSV manifest id,class,path");

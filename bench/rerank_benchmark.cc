@@ -110,7 +110,10 @@ void BM_RerankQuery(benchmark::State& state) {
   if (!built.count(n)) {
     Collection c = MakeCollection(n, 7);
     NeighborGraph g = Graph(c, options.graph_k(), n > 20000);
-    std::fprintf(stderr, "graph of %zu models, lists of %d: %.1f MB\n", n, g.k(),
+    std::fprintf(stderr,
+                 "graph of %zu models, lists of %d: %.1f MB\n",
+                 n,
+                 g.k(),
                  n * g.k() * sizeof(GraphNeighbor) / 1e6);
     built.emplace(n, std::make_pair(std::move(c), std::move(g)));
   }

@@ -251,40 +251,44 @@ int main(int argc, char** argv) {
       options.weighting = {};  // each --weightings entry below
       const auto encoded = EncodeCollection(*codebook, *features, options);
       for (absl::string_view weighting : absl::StrSplit(absl::GetFlag(FLAGS_weightings), ',')) {
-      for (absl::string_view distance : absl::StrSplit(absl::GetFlag(FLAGS_distances), ',')) {
-      for (double eps : distance == "kl" ? epsilons : std::vector<double>{0}) {
-        std::vector<std::vector<float>> histograms = *encoded;
-        if (absl::Status s = WeightCollection(ParseWeighting(std::string(weighting)), &histograms);
-            !s.ok()) {
-          std::fprintf(stderr, "%s\n", s.ToString().c_str());
-          return 1;
+        for (absl::string_view distance : absl::StrSplit(absl::GetFlag(FLAGS_distances), ',')) {
+          for (double eps : distance == "kl" ? epsilons : std::vector<double>{0}) {
+            std::vector<std::vector<float>> histograms = *encoded;
+            if (absl::Status s =
+                    WeightCollection(ParseWeighting(std::string(weighting)), &histograms);
+                !s.ok()) {
+              std::fprintf(stderr, "%s\n", s.ToString().c_str());
+              return 1;
+            }
+            std::vector<float> matrix;
+            if (distance == "kl") {
+              options.kl.epsilon = eps;
+              matrix = *RankCollection(histograms, options);
+            } else {
+              matrix = DenseDistances(std::string(distance), histograms);
+            }
+            auto metrics = EvaluateRetrieval(labels, matrix, options.num_threads);
+            const std::string row =
+                absl::StrFormat("%s %s %s,%g,%d,%g,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.1f",
+                                absl::GetFlag(FLAGS_tag),
+                                weighting,
+                                distance,
+                                scale,
+                                v,
+                                eps,
+                                100 * metrics->micro.rp_excl,
+                                100 * metrics->macro.rp_excl,
+                                100 * metrics->micro.rp_incl,
+                                100 * metrics->micro.nn,
+                                100 * metrics->micro.second_tier,
+                                100 * metrics->micro.dcg,
+                                extract_s);
+            std::printf("%s\n", row.c_str());
+            std::fflush(stdout);
+            if (!absl::GetFlag(FLAGS_csv).empty())
+              std::ofstream(absl::GetFlag(FLAGS_csv), std::ios::app) << row << "\n";
+          }
         }
-        std::vector<float> matrix;
-        if (distance == "kl") {
-          options.kl.epsilon = eps;
-          matrix = *RankCollection(histograms, options);
-        } else {
-          matrix = DenseDistances(std::string(distance), histograms);
-        }
-        auto metrics = EvaluateRetrieval(labels, matrix, options.num_threads);
-        const std::string row = absl::StrFormat("%s %s %s,%g,%d,%g,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.1f",
-                                                absl::GetFlag(FLAGS_tag), weighting, distance,
-                                                scale,
-                                                v,
-                                                eps,
-                                                100 * metrics->micro.rp_excl,
-                                                100 * metrics->macro.rp_excl,
-                                                100 * metrics->micro.rp_incl,
-                                                100 * metrics->micro.nn,
-                                                100 * metrics->micro.second_tier,
-                                                100 * metrics->micro.dcg,
-                                                extract_s);
-        std::printf("%s\n", row.c_str());
-        std::fflush(stdout);
-        if (!absl::GetFlag(FLAGS_csv).empty())
-          std::ofstream(absl::GetFlag(FLAGS_csv), std::ios::app) << row << "\n";
-      }
-      }
       }
     }
   }

@@ -3,11 +3,11 @@
 // stack on --data_dir for its duration.
 #include <algorithm>
 #include <cstdio>
-#include <thread>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
+#include <thread>
 
 #include "absl/flags/declare.h"
 #include "absl/flags/flag.h"
@@ -407,7 +407,8 @@ absl::Status RunServe() {
 bool EvalInProcess() { return absl::GetFlag(FLAGS_server) == "in-process"; }
 
 absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
-    const std::vector<ManifestEntry>& models, const CollectionOptions& options,
+    const std::vector<ManifestEntry>& models,
+    const CollectionOptions& options,
     const std::string& manifest_path) {
   const auto start = absl::Now();
   MESHSEEK_ASSIGN_OR_RETURN(auto session, Session::Open());

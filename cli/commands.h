@@ -4,7 +4,6 @@
 #define MESHSEEK_CLI_COMMANDS_H_
 
 #include <string>
-
 #include <vector>
 
 #include "absl/status/status.h"

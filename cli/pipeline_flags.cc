@@ -82,9 +82,10 @@ absl::StatusOr<CollectionOptions> CollectionOptionsFromFlags() {
 absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags() {
   MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromFlags());
   if (options.fused() || options.rerank.enabled()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "flags: this command works with one method, got --method ", options.MethodName(),
-        options.rerank.enabled() ? " with --rerank" : ""));
+    return absl::InvalidArgumentError(
+        absl::StrCat("flags: this command works with one method, got --method ",
+                     options.MethodName(),
+                     options.rerank.enabled() ? " with --rerank" : ""));
   }
   return options.methods.front();
 }

@@ -3,18 +3,18 @@
 // of an extract worker, of the index and of the coordinator loses no
 // acknowledged model; bad input gets the right status code and a message
 // naming the problem, and the servers keep serving.
+#include <fcntl.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
-#include <netinet/in.h>
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -25,8 +25,8 @@
 #include "common/geometry/mesh_io.h"
 #include "common/pipeline/collection_evaluation.h"
 #include "common/rpc/client.h"
-#include "common/rpc/free_port.h"
 #include "common/rpc/convert.h"
+#include "common/rpc/free_port.h"
 #include "common/rpc/status.h"
 #include "common/synth/synthetic_benchmark.h"
 #include "gmock/gmock.h"
@@ -652,9 +652,14 @@ TEST_F(ServicesTest, AGlobalDescriptorCollectionSurvivesKillsAndEqualsInProcess)
 TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
   v1::PipelineParams params;
   for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
-           {"method", "lsf+lfd"}, {"points", "128"}, {"vocabulary", "64"}, {"view_size", "64"},
+           {"method", "lsf+lfd"},
+           {"points", "128"},
+           {"vocabulary", "64"},
+           {"view_size", "64"},
            {"histogram_power", "0.5"},  // LSF's histograms square-rooted, in the coordinator
-           {"rerank_k1", "5"}, {"rerank_k2", "2"}, {"rerank_depth", "20"}}) {
+           {"rerank_k1", "5"},
+           {"rerank_k2", "2"},
+           {"rerank_depth", "20"}}) {
     v1::ParamValue* v = params.add_values();
     v->set_name(name);
     v->set_value(value);

@@ -35,8 +35,8 @@ absl::Status WeightHistogram(const HistogramWeighting& weighting,
                              absl::Span<const float> idf,
                              absl::Span<float> histogram) {
   if (!idf.empty() && idf.size() != histogram.size()) {
-    return absl::InvalidArgumentError(absl::StrCat("histogram of ", histogram.size(),
-                                                   " words weighted by an idf of ", idf.size()));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "histogram of ", histogram.size(), " words weighted by an idf of ", idf.size()));
   }
   double sum = 0;
   for (std::size_t k = 0; k < histogram.size(); ++k) {

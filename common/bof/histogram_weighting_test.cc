@@ -65,8 +65,7 @@ TEST(HistogramWeightingTest, IdfOfAnotherLengthIsRefused) {
   w.idf = true;
   std::vector<float> h = {0.5f, 0.5f};
   const std::vector<float> idf = {1.0f, 1.0f, 1.0f};
-  EXPECT_EQ(WeightHistogram(w, idf, absl::MakeSpan(h)).code(),
-            absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(WeightHistogram(w, idf, absl::MakeSpan(h)).code(), absl::StatusCode::kInvalidArgument);
 }
 
 TEST(HistogramWeightingTest, EveryHistogramEmptyGivesNoIdf) {

@@ -87,9 +87,8 @@ absl::StatusOr<std::vector<float>> CombineMethodDistances(
   if (!options.rerank.enabled()) return fused;
 
   start = std::chrono::steady_clock::now();
-  MESHSEEK_ASSIGN_OR_RETURN(
-      const NeighborGraph graph,
-      NeighborGraph::FromMatrix(fused, n, options.rerank.graph_k(), threads));
+  MESHSEEK_ASSIGN_OR_RETURN(const NeighborGraph graph,
+                            NeighborGraph::FromMatrix(fused, n, options.rerank.graph_k(), threads));
   MESHSEEK_ASSIGN_OR_RETURN(std::vector<float> ranked,
                             RerankMatrix(graph, fused, options.rerank, threads));
   if (rerank_seconds != nullptr) *rerank_seconds = SecondsSince(start);
@@ -114,9 +113,10 @@ absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<Manife
   std::vector<absl::Span<const float>> matrices;
   for (const MethodEvaluation& m : result.methods) matrices.push_back(m.distances);
   std::vector<double> scales;
-  MESHSEEK_ASSIGN_OR_RETURN(result.distances,
-                            CombineMethodDistances(matrices, models.size(), options, &scales,
-                                                   &result.fuse_seconds, &result.rerank_seconds));
+  MESHSEEK_ASSIGN_OR_RETURN(
+      result.distances,
+      CombineMethodDistances(
+          matrices, models.size(), options, &scales, &result.fuse_seconds, &result.rerank_seconds));
   for (std::size_t m = 0; m < scales.size(); ++m) result.methods[m].scale = scales[m];
 
   std::vector<std::string> labels;
@@ -145,7 +145,8 @@ absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
     for (const MethodEvaluation& m : evaluation.methods) {
       if (m.distances.empty()) continue;
       MESHSEEK_RETURN_IF_ERROR(WriteDistanceMatrix(
-          absl::StrCat(out_dir, "/distances.", FeatureMethodName(m.method), ".bin"), m.distances,
+          absl::StrCat(out_dir, "/distances.", FeatureMethodName(m.method), ".bin"),
+          m.distances,
           evaluation.models.size()));
     }
   }

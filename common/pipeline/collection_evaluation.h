@@ -56,8 +56,8 @@ absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<Manife
 
 // Writes DIR/distances.bin (PSB float32 matrix, manifest order), for a
 // collection of several methods each one's own as DIR/distances.METHOD.bin
-// (when evaluated in process), and DIR/metrics.json (every metric, micro and macro, per class, the parameters,
-// feature counts, each method's scale and the stage timings). Creates DIR.
+// (when evaluated in process), and DIR/metrics.json (every metric, micro and macro, per class, the
+// parameters, feature counts, each method's scale and the stage timings). Creates DIR.
 absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
                              const CollectionOptions& options,
                              const std::string& out_dir);

@@ -108,23 +108,26 @@ TEST(EvaluateCollectionTest, AFusedCollectionCombinesItsMethodsEvaluatedAlone) {
     matrices.push_back(fused->methods[m].distances);
   }
   std::vector<double> scales;
-  EXPECT_EQ(*CombineMethodDistances(matrices, models->size(), *options, &scales),
-            fused->distances);
+  EXPECT_EQ(*CombineMethodDistances(matrices, models->size(), *options, &scales), fused->distances);
   EXPECT_EQ(fused->methods[1].scale, scales[1]);
 
   ASSERT_TRUE(WriteEvaluation(*fused, *options, dir + "/eval").ok());
   auto read = ReadFileToString(dir + "/eval/metrics.json");
   ASSERT_TRUE(read.ok());
   const std::string& json = *read;
-  for (const char* key : {"\"method\": \"lsf+lfd\"", "\"lsf\": {", "\"weights\": [", "\"rerank\": \"kreciprocal\"",
-                          "\"distance_scales\"", "\"rerank_k1\": 4"}) {
+  for (const char* key : {"\"method\": \"lsf+lfd\"",
+                          "\"lsf\": {",
+                          "\"weights\": [",
+                          "\"rerank\": \"kreciprocal\"",
+                          "\"distance_scales\"",
+                          "\"rerank_k1\": 4"}) {
     EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
   }
   // Each method's own matrix beside the fused one, for the ablation.
   for (std::size_t m = 0; m < 2; ++m) {
     const std::string method(FeatureMethodName(fused->methods[m].method));
-    auto matrix = ReadDistanceMatrix(absl::StrCat(dir, "/eval/distances.", method, ".bin"),
-                                     models->size());
+    auto matrix =
+        ReadDistanceMatrix(absl::StrCat(dir, "/eval/distances.", method, ".bin"), models->size());
     ASSERT_TRUE(matrix.ok()) << method << ": " << matrix.status();
     EXPECT_EQ(*matrix, fused->methods[m].distances) << method;
   }

@@ -11,8 +11,7 @@
 
 namespace meshseek {
 
-CollectionOptions::CollectionOptions()
-    : methods({RetrievalPipelineOptions()}), weights({1.0}) {
+CollectionOptions::CollectionOptions() : methods({RetrievalPipelineOptions()}), weights({1.0}) {
   rerank.method = RerankOptions::Method::kNone;
 }
 
@@ -69,8 +68,13 @@ absl::Status CollectionOptions::Validate() const {
     MESHSEEK_RETURN_IF_ERROR(m.Validate());
   }
   if (weights.size() != methods.size()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "weights: ", weights.size(), " given for ", methods.size(), " methods (", MethodName(), ")"));
+    return absl::InvalidArgumentError(absl::StrCat("weights: ",
+                                                   weights.size(),
+                                                   " given for ",
+                                                   methods.size(),
+                                                   " methods (",
+                                                   MethodName(),
+                                                   ")"));
   }
   double total = 0;
   for (double w : weights) {

@@ -141,11 +141,8 @@ ParamSpec Choice(std::string name,
 
 // A parameter of the collection (fusion, re-ranking) stored in one field.
 template <typename T>
-ParamSpec CollectionField(std::string name,
-                          std::string doc,
-                          double min,
-                          double max,
-                          T& (*field)(CollectionOptions&)) {
+ParamSpec CollectionField(
+    std::string name, std::string doc, double min, double max, T& (*field)(CollectionOptions&)) {
   ParamSpec spec;
   spec.name = std::move(name);
   spec.type = TypeOf<T>();
@@ -680,7 +677,8 @@ absl::StatusOr<CollectionOptions> CollectionOptionsFromValues(const ParamValues&
   if (methods.size() > CollectionOptions::kMaxMethods) {
     return absl::InvalidArgumentError(absl::StrCat("parameter method: at most ",
                                                    CollectionOptions::kMaxMethods,
-                                                   " methods, got ", methods.size()));
+                                                   " methods, got ",
+                                                   methods.size()));
   }
   CollectionOptions options = CollectionOptions::ForMethods(methods);
   for (const auto& [name, value] : values) {
@@ -695,8 +693,13 @@ absl::StatusOr<CollectionOptions> CollectionOptionsFromValues(const ParamValues&
             absl::StrCat("parameter ", name, ": ", m.status().message()));
       }
       if (std::find(methods.begin(), methods.end(), *m) == methods.end()) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "parameter ", name, ": method ", plain.substr(0, dot), " is not in '", method_list, "'"));
+        return absl::InvalidArgumentError(absl::StrCat("parameter ",
+                                                       name,
+                                                       ": method ",
+                                                       plain.substr(0, dot),
+                                                       " is not in '",
+                                                       method_list,
+                                                       "'"));
       }
       only = *m;
       plain = plain.substr(dot + 1);
@@ -707,7 +710,10 @@ absl::StatusOr<CollectionOptions> CollectionOptionsFromValues(const ParamValues&
       std::vector<std::string> known;
       for (const ParamSpec& s : PipelineParamSpecs()) known.push_back(s.name);
       return absl::InvalidArgumentError(
-          absl::StrCat("unknown parameter '", name, "' (known: ", absl::StrJoin(known, ", "),
+          absl::StrCat("unknown parameter '",
+                       name,
+                       "' (known: ",
+                       absl::StrJoin(known, ", "),
                        "; a method's may be qualified: rld.vocabulary)"));
     }
     MESHSEEK_RETURN_IF_ERROR(CheckValue(*spec, value));
@@ -723,14 +729,14 @@ absl::StatusOr<CollectionOptions> CollectionOptionsFromValues(const ParamValues&
       applied = true;
     }
     if (!applied) {
-      return absl::InvalidArgumentError(absl::StrCat("parameter ",
-                                                     name,
-                                                     " does not apply to method ",
-                                                     only.has_value() ? FeatureMethodName(*only)
-                                                                      : method_list.c_str(),
-                                                     " (it applies to ",
-                                                     MethodNames(*spec),
-                                                     ")"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("parameter ",
+                       name,
+                       " does not apply to method ",
+                       only.has_value() ? FeatureMethodName(*only) : method_list.c_str(),
+                       " (it applies to ",
+                       MethodNames(*spec),
+                       ")"));
     }
   }
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
@@ -763,9 +769,11 @@ ParamValues CollectionValuesOf(const CollectionOptions& options) {
 absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromValues(const ParamValues& values) {
   MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromValues(values));
   if (options.fused() || options.rerank.enabled()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "parameters of one method were expected, got '", options.MethodName(), "'",
-        options.rerank.enabled() ? " with re-ranking" : ""));
+    return absl::InvalidArgumentError(
+        absl::StrCat("parameters of one method were expected, got '",
+                     options.MethodName(),
+                     "'",
+                     options.rerank.enabled() ? " with re-ranking" : ""));
   }
   return options.methods.front();
 }
@@ -778,37 +786,37 @@ namespace {
 
 // Sets json[spec.name] to `text` as the spec's type.
 void SetTyped(const ParamSpec& spec, const std::string& text, Json* json) {
-    switch (spec.type) {
-      case ParamType::kInt:
-      case ParamType::kUint64: {
-        int64_t v = 0;
-        if (absl::SimpleAtoi(text, &v)) {
-          json->Set(spec.name, v);
-        } else {
-          json->Set(spec.name, text);  // a uint64 beyond int64: exact as text
-        }
-        break;
-      }
-      case ParamType::kDouble: {
-        double v = 0;
-        (void)absl::SimpleAtod(text, &v);
+  switch (spec.type) {
+    case ParamType::kInt:
+    case ParamType::kUint64: {
+      int64_t v = 0;
+      if (absl::SimpleAtoi(text, &v)) {
         json->Set(spec.name, v);
-        break;
+      } else {
+        json->Set(spec.name, text);  // a uint64 beyond int64: exact as text
       }
-      case ParamType::kBool:
-        json->Set(spec.name, text == "true");
-        break;
-      case ParamType::kChoice:
-        json->Set(spec.name, text);
-        break;
-      case ParamType::kDoubleList: {
-        Json& list = json->Set(spec.name, Json::MakeArray());
-        std::vector<double> values;
-        Parse(text, &values);
-        for (double v : values) list.Push(v);
-        break;
-      }
+      break;
     }
+    case ParamType::kDouble: {
+      double v = 0;
+      (void)absl::SimpleAtod(text, &v);
+      json->Set(spec.name, v);
+      break;
+    }
+    case ParamType::kBool:
+      json->Set(spec.name, text == "true");
+      break;
+    case ParamType::kChoice:
+      json->Set(spec.name, text);
+      break;
+    case ParamType::kDoubleList: {
+      Json& list = json->Set(spec.name, Json::MakeArray());
+      std::vector<double> values;
+      Parse(text, &values);
+      for (double v : values) list.Push(v);
+      break;
+    }
+  }
 }
 
 }  // namespace
@@ -838,7 +846,8 @@ std::string PipelineParamsUsage() {
       const std::string one = spec.collection_get(CollectionOptions());
       const std::string several = spec.collection_get(
           CollectionOptions::ForMethods({FeatureMethod::kBfDsift, FeatureMethod::kRldSift}));
-      std::string value = one == several ? one : absl::StrCat("one method ", one, ", several ", several);
+      std::string value =
+          one == several ? one : absl::StrCat("one method ", one, ", several ", several);
       if (spec.name == "weights") {
         std::vector<std::string> own;
         for (const FeatureMethodInfo& m : FeatureMethods()) {
@@ -846,8 +855,16 @@ std::string PipelineParamsUsage() {
         }
         value = absl::StrCat("each method's own: ", absl::StrJoin(own, ", "));
       }
-      absl::StrAppend(&usage, "  --", spec.name, "  ", spec.TypeDescription(), "; ", spec.doc,
-                      "\n      the collection; default: ", value, "\n");
+      absl::StrAppend(&usage,
+                      "  --",
+                      spec.name,
+                      "  ",
+                      spec.TypeDescription(),
+                      "; ",
+                      spec.doc,
+                      "\n      the collection; default: ",
+                      value,
+                      "\n");
       continue;
     }
     // "default: 20" when every method has the same, else "default: rld 15, ld 20".

@@ -19,8 +19,8 @@
 // to every named method it applies to ("vocabulary" to each bag-of-features
 // method), or to one when qualified by the method's name ("rld.vocabulary");
 // the canonical form of a fused collection qualifies every one. Collection
-// parameters (weights, rerank, ...) are never qualified. A parameter's default is its option struct's
-// value for the selected method (a method may set its own defaults:
+// parameters (weights, rerank, ...) are never qualified. A parameter's default is its option
+// struct's value for the selected method (a method may set its own defaults:
 // FeatureMethodInfo::vocabulary), so the table never restates a default.
 #ifndef MESHSEEK_COMMON_PIPELINE_PIPELINE_PARAMS_H_
 #define MESHSEEK_COMMON_PIPELINE_PIPELINE_PARAMS_H_

@@ -41,8 +41,8 @@ TEST(PipelineParamsTest, NamesAreUniqueAndEveryDefaultLiesInItsOwnRange) {
     EXPECT_FALSE(spec.doc.empty()) << spec.name;
     if (spec.scope == ParamSpec::Scope::kCollection) {
       for (const CollectionOptions& c :
-           {CollectionOptions(), CollectionOptions::ForMethods({FeatureMethod::kRldSift,
-                                                                FeatureMethod::kLfd})}) {
+           {CollectionOptions(),
+            CollectionOptions::ForMethods({FeatureMethod::kRldSift, FeatureMethod::kLfd})}) {
         const std::string value = spec.collection_get(c);
         const auto back =
             CollectionOptionsFromValues({{"method", c.MethodName()}, {spec.name, value}});
@@ -151,7 +151,8 @@ TEST(PipelineParamsTest, PlainParametersSetEveryMethodTheyApplyToQualifiedOnesOn
   // Canonical: every method's parameters qualified, then the collection's.
   const ParamValues values = CollectionValuesOf(*c);
   EXPECT_EQ(values.front(), (std::pair<std::string, std::string>{"method", "rld+dld+lfd"}));
-  EXPECT_NE(std::find(values.begin(), values.end(),
+  EXPECT_NE(std::find(values.begin(),
+                      values.end(),
                       std::pair<std::string, std::string>{"dld.vocabulary", "500"}),
             values.end());
   auto back = CollectionOptionsFromValues(values);

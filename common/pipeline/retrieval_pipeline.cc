@@ -44,8 +44,7 @@ RetrievalPipelineOptions RetrievalPipelineOptions::ForMethod(FeatureMethod metho
   // A global method has no codebook: the (unused) default stays.
   if (FeatureMethodInfoOf(method).vocabulary > 0) {
     options.kmeans.num_centroids = FeatureMethodInfoOf(method).vocabulary;
-    options.kmeans.max_points_per_centroid =
-        FeatureMethodInfoOf(method).kmeans_points_per_centroid;
+    options.kmeans.max_points_per_centroid = FeatureMethodInfoOf(method).kmeans_points_per_centroid;
     options.weighting.power = FeatureMethodInfoOf(method).histogram_power;
   }
   return options;

@@ -29,8 +29,8 @@ double DistanceScale::Scale() const {
 absl::StatusOr<std::vector<double>> FusionFactors(absl::Span<const double> weights,
                                                   absl::Span<const double> scales) {
   if (weights.size() != scales.size() || weights.empty()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "fusion: ", weights.size(), " weights for ", scales.size(), " methods"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("fusion: ", weights.size(), " weights for ", scales.size(), " methods"));
   }
   double total = 0.0;
   for (std::size_t m = 0; m < weights.size(); ++m) {

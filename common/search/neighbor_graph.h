@@ -31,9 +31,7 @@ namespace meshseek {
 struct GraphNeighbor {
   uint32_t node = 0;
   float distance = 0.0f;
-  bool operator==(const GraphNeighbor& o) const {
-    return node == o.node && distance == o.distance;
-  }
+  bool operator==(const GraphNeighbor& o) const { return node == o.node && distance == o.distance; }
 };
 
 /// Orders neighbours of `self`'s list: itself first, then by (distance, node).

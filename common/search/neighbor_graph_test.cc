@@ -36,9 +36,15 @@ TEST(NeighborGraphTest, ListsStartWithTheModelThenNearestTiesByNode) {
 
 TEST(NeighborGraphTest, ShortCollectionsKeepEveryModelAndInfinityRanksLast) {
   const float inf = std::numeric_limits<float>::infinity();
-  const std::vector<float> d = {0, inf, 2,  //
-                                inf, 0, inf,
-                                2, inf, 0};
+  const std::vector<float> d = {0,
+                                inf,
+                                2,  //
+                                inf,
+                                0,
+                                inf,
+                                2,
+                                inf,
+                                0};
   auto graph = NeighborGraph::FromMatrix(d, 3, 10);
   ASSERT_TRUE(graph.ok());
   EXPECT_EQ(graph->k(), 3);

@@ -114,9 +114,8 @@ SparseVector ExpandedVector(const GraphView& view,
     sum.insert(sum.end(), it->second.begin(), it->second.end());
   }
   // Merge equal nodes; stable so each node's terms add in list order.
-  std::stable_sort(sum.begin(), sum.end(), [](const auto& a, const auto& b) {
-    return a.first < b.first;
-  });
+  std::stable_sort(
+      sum.begin(), sum.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   SparseVector out;
   for (const auto& [node, w] : sum) {
     if (!out.empty() && out.back().first == node) {
@@ -161,8 +160,11 @@ absl::Status CheckInputs(const NeighborGraph& graph,
   }
   if (static_cast<std::size_t>(graph.k()) < std::min<std::size_t>(options.graph_k(), n)) {
     return absl::InvalidArgumentError(absl::StrCat("re-ranking: the neighbour graph keeps ",
-                                                   graph.k(), " neighbours, k1 = ", options.k1,
-                                                   " needs ", options.graph_k()));
+                                                   graph.k(),
+                                                   " neighbours, k1 = ",
+                                                   options.k1,
+                                                   " needs ",
+                                                   options.graph_k()));
   }
   if (self.has_value() && *self >= n) {
     return absl::InvalidArgumentError(
@@ -190,8 +192,7 @@ std::vector<float> Rerank(const GraphView& view,
   const double lambda = options.lambda;
   std::vector<float> out(n);
   for (std::size_t j = 0; j < n; ++j) {
-    out[j] = std::isinf(row[j]) ? kInfinity
-                                : static_cast<float>((1.0 - lambda) + lambda * row[j]);
+    out[j] = std::isinf(row[j]) ? kInfinity : static_cast<float>((1.0 - lambda) + lambda * row[j]);
   }
   // The query itself (a model of the collection) and the `depth` others
   // nearest by the original distance.
@@ -201,12 +202,11 @@ std::vector<float> Rerank(const GraphView& view,
     order[j] = GraphNeighbor{j, self.has_value() && j == *self ? 0.0f : row[j]};
   }
   const std::size_t depth = std::min<std::size_t>(options.depth + (self.has_value() ? 1 : 0), n);
-  std::partial_sort(order.begin(),
-                    order.begin() + depth,
-                    order.end(),
-                    [q](const GraphNeighbor& a, const GraphNeighbor& b) {
-                      return NeighborBefore(q, a, b);
-                    });
+  std::partial_sort(
+      order.begin(),
+      order.begin() + depth,
+      order.end(),
+      [q](const GraphNeighbor& a, const GraphNeighbor& b) { return NeighborBefore(q, a, b); });
   for (std::size_t r = 0; r < depth; ++r) {
     const uint32_t c = order[r].node;
     if (std::isinf(row[c])) continue;

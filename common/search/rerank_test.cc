@@ -107,18 +107,32 @@ TEST(RerankTest, AQueryJoiningTheGraphRanksAsIfItHadBeenAModel) {
   auto large = NeighborGraph::FromMatrix(all, n + 1, options.graph_k());
   ASSERT_TRUE(small.ok() && large.ok());
   auto joined = RerankRow(*small, query, std::nullopt, options);
-  auto member = RerankRow(
-      *large, absl::MakeConstSpan(all).subspan(n * (n + 1), n + 1), static_cast<uint32_t>(n), options);
+  auto member = RerankRow(*large,
+                          absl::MakeConstSpan(all).subspan(n * (n + 1), n + 1),
+                          static_cast<uint32_t>(n),
+                          options);
   ASSERT_TRUE(joined.ok() && member.ok());
   for (std::size_t j = 0; j < n; ++j) EXPECT_EQ((*joined)[j], (*member)[j]) << j;
 }
 
 TEST(RerankTest, UnrankableModelsStayLastAndNoneLeavesRowsAlone) {
   const float inf = std::numeric_limits<float>::infinity();
-  const std::vector<float> d = {0, 0.2f, inf, 0.5f,  //
-                                0.2f, 0, inf, 0.4f,
-                                inf, inf, 0, inf,
-                                0.5f, 0.4f, inf, 0};
+  const std::vector<float> d = {0,
+                                0.2f,
+                                inf,
+                                0.5f,  //
+                                0.2f,
+                                0,
+                                inf,
+                                0.4f,
+                                inf,
+                                inf,
+                                0,
+                                inf,
+                                0.5f,
+                                0.4f,
+                                inf,
+                                0};
   RerankOptions options;
   options.k1 = 2;
   options.k2 = 2;

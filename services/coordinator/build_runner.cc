@@ -48,9 +48,11 @@ void BuildRunner::Done(const std::string& collection) {
 absl::StatusOr<std::string> BuildRunner::Start(const std::string& collection) {
   MESHSEEK_ASSIGN_OR_RETURN(const CollectionPlan plan, LoadCollectionPlan(store_, collection));
   if (plan.member) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "collection '", collection, "' is a member of '",
-        collection.substr(0, collection.find('~')), "': build that one"));
+    return absl::InvalidArgumentError(absl::StrCat("collection '",
+                                                   collection,
+                                                   "' is a member of '",
+                                                   collection.substr(0, collection.find('~')),
+                                                   "': build that one"));
   }
   {
     absl::MutexLock lock(&mutex_);
@@ -149,14 +151,15 @@ absl::Status BuildRunner::BuildPart(const std::string& job_id,
                                     const std::optional<std::set<std::string>>& eligible) {
   const std::string codebook_id = absl::StrCat(part.name, "@", job_id);
   const absl::Time start = absl::Now();
-  MESHSEEK_ASSIGN_OR_RETURN(std::vector<ExtractedModel> members, store_->ExtractedModels(part.name));
+  MESHSEEK_ASSIGN_OR_RETURN(std::vector<ExtractedModel> members,
+                            store_->ExtractedModels(part.name));
   if (eligible.has_value()) {
     // A fused collection's models extracted by every method, the same in each part.
-    members.erase(std::remove_if(members.begin(), members.end(),
-                                 [&](const ExtractedModel& m) {
-                                   return eligible->count(m.model_id) == 0;
-                                 }),
-                  members.end());
+    members.erase(
+        std::remove_if(members.begin(),
+                       members.end(),
+                       [&](const ExtractedModel& m) { return eligible->count(m.model_id) == 0; }),
+        members.end());
   }
   // Parsed once, for training and encoding; the stored bytes are let go.
   std::vector<v1::LocalFeatures> features(members.size());
@@ -170,8 +173,8 @@ absl::Status BuildRunner::BuildPart(const std::string& job_id,
   }
   // 1. The codebook, unless a resumed build trained it already or the method
   // is global (then the id only names this generation of the index).
-  const bool global = FeatureMethodInfoOf(part.options.extractor.method).kind ==
-                      DescriptorKind::kGlobal;
+  const bool global =
+      FeatureMethodInfoOf(part.options.extractor.method).kind == DescriptorKind::kGlobal;
   if (!global) {
     if (absl::Status trained = Train(codebook_id, part, features); !trained.ok()) {
       return Prefixed(trained, "codebook training: ");
@@ -238,7 +241,8 @@ void BuildRunner::Run(const std::string& job_id, const std::string& collection) 
   const std::string codebook_id = absl::StrCat(collection, "@", job_id);
   if (plan->options.rescaled()) {
     const absl::Time start = absl::Now();
-    for (CollectionInfo& part : plan->parts) part.codebook_id = absl::StrCat(part.name, "@", job_id);
+    for (CollectionInfo& part : plan->parts)
+      part.codebook_id = absl::StrCat(part.name, "@", job_id);
     absl::StatusOr<RankingState> state = ComputeRankingState(workers_->index(), *plan);
     if (*stop_) return Done(collection);
     if (!state.ok()) return fail(Prefixed(state.status(), "ranking: "));
@@ -255,8 +259,8 @@ void BuildRunner::Run(const std::string& job_id, const std::string& collection) 
   const uint64_t indexed = counts.ok() ? counts->indexed : 0;
   std::string message = absl::StrCat(indexed, " models indexed with codebook ", codebook_id);
   if (plan->fused()) {
-    message = absl::StrCat(indexed, " models indexed by ", plan->options.MethodName(),
-                           " (build ", job_id, ")");
+    message = absl::StrCat(
+        indexed, " models indexed by ", plan->options.MethodName(), " (build ", job_id, ")");
   }
   if (failed > 0) {
     absl::StrAppend(&message, "; ", failed, " failed models left out (meshseek status --collection ",

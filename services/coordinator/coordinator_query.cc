@@ -144,12 +144,16 @@ grpc::Status CoordinatorService::Evaluate(grpc::ServerContext* context,
   if (!collection.ok()) return rpc::ToGrpcStatus(collection.status());
   if (collection->codebook_id().empty() || collection->indexed() != collection->extracted() ||
       collection->pending() > 0) {
-    return grpc::Status(
-        grpc::StatusCode::FAILED_PRECONDITION,
-        absl::StrCat("collection '", request->collection(), "' has ", collection->extracted(),
-                     " extracted models of which ", collection->indexed(),
-                     " are indexed with its current codebook, and ", collection->pending(),
-                     " pending; build it first"));
+    return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
+                        absl::StrCat("collection '",
+                                     request->collection(),
+                                     "' has ",
+                                     collection->extracted(),
+                                     " extracted models of which ",
+                                     collection->indexed(),
+                                     " are indexed with its current codebook, and ",
+                                     collection->pending(),
+                                     " pending; build it first"));
   }
   std::shared_ptr<const Ranking> ranking;
   if (plan->options.rescaled()) {
@@ -190,9 +194,11 @@ grpc::Status CoordinatorService::Evaluate(grpc::ServerContext* context,
           // collection changed since.
           if (rows >= ranking->state.model_ids.size() ||
               ranking->state.model_ids[rows] != row.model->model_id()) {
-            return absl::FailedPreconditionError(
-                absl::StrCat("collection '", request->collection(), "' changed since build ",
-                             ranking->build, "; build it again"));
+            return absl::FailedPreconditionError(absl::StrCat("collection '",
+                                                              request->collection(),
+                                                              "' changed since build ",
+                                                              ranking->build,
+                                                              "; build it again"));
           }
           MESHSEEK_ASSIGN_OR_RETURN(
               const std::vector<float> ranked,
@@ -214,7 +220,10 @@ grpc::Status CoordinatorService::Evaluate(grpc::ServerContext* context,
   if (!streamed.ok()) return rpc::ToGrpcStatus(streamed);
   if (rows != collection->indexed()) {
     return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
-                        absl::StrCat("index returned ", rows, " rows for ", collection->indexed(),
+                        absl::StrCat("index returned ",
+                                     rows,
+                                     " rows for ",
+                                     collection->indexed(),
                                      " indexed models; build again"));
   }
   return grpc::Status::OK;

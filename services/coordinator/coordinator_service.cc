@@ -71,7 +71,9 @@ void CoordinatorService::Stop() {
 absl::StatusOr<CollectionPlan> CoordinatorService::PublicPlan(const std::string& name) {
   MESHSEEK_ASSIGN_OR_RETURN(CollectionPlan plan, LoadCollectionPlan(store_.get(), name));
   if (plan.member) {
-    return absl::InvalidArgumentError(absl::StrCat("collection '", name, "' is a member of '",
+    return absl::InvalidArgumentError(absl::StrCat("collection '",
+                                                   name,
+                                                   "' is a member of '",
                                                    name.substr(0, name.find('~')),
                                                    "': use that one"));
   }
@@ -108,7 +110,9 @@ grpc::Status CoordinatorService::CreateCollection(grpc::ServerContext*,
     if (method.weighting.idf) {
       return grpc::Status(
           grpc::StatusCode::INVALID_ARGUMENT,
-          absl::StrCat("collection '", request->name(), "': idf=true needs the whole "
+          absl::StrCat("collection '",
+                       request->name(),
+                       "': idf=true needs the whole "
                        "collection's document frequencies, which the services do not keep; "
                        "evaluate it in process (meshseek eval --server in-process)"));
     }
@@ -160,8 +164,8 @@ grpc::Status CoordinatorService::ListModels(grpc::ServerContext*,
                                             v1::ListCollectionModelsResponse* response) {
   absl::StatusOr<CollectionPlan> plan = PublicPlan(request->collection());
   if (!plan.ok()) return rpc::ToGrpcStatus(plan.status());
-  absl::StatusOr<v1::ListCollectionModelsResponse> models = store_->ListModels(
-      *request, plan->fused() ? plan->PartNames() : std::vector<std::string>());
+  absl::StatusOr<v1::ListCollectionModelsResponse> models =
+      store_->ListModels(*request, plan->fused() ? plan->PartNames() : std::vector<std::string>());
   if (!models.ok()) return rpc::ToGrpcStatus(models.status());
   *response = *std::move(models);
   return grpc::Status::OK;
@@ -196,9 +200,9 @@ grpc::Status CoordinatorService::WatchJob(grpc::ServerContext* context,
 
 // --------------------------------------------------------------------- ingest
 
-absl::StatusOr<v1::IngestAck> CoordinatorService::AcceptModel(
-    const v1::IngestRequest& request, const std::vector<std::string>& parts,
-    const std::string& job_id) {
+absl::StatusOr<v1::IngestAck> CoordinatorService::AcceptModel(const v1::IngestRequest& request,
+                                                              const std::vector<std::string>& parts,
+                                                              const std::string& job_id) {
   MESHSEEK_RETURN_IF_ERROR(CheckName("model id", request.model_id(), 256, false));
   if (request.label().size() > 256) {
     return absl::InvalidArgumentError(absl::StrCat("model ", request.model_id(), ": label of ",
@@ -211,8 +215,8 @@ absl::StatusOr<v1::IngestAck> CoordinatorService::AcceptModel(
   rpc::MeshToProto(*mesh, &stored);
   MESHSEEK_ASSIGN_OR_RETURN(
       const CoordinatorStore::AddedModel added,
-      store_->AddModel(parts, request.model_id(), request.label(), stored.SerializeAsString(),
-                       job_id));
+      store_->AddModel(
+          parts, request.model_id(), request.label(), stored.SerializeAsString(), job_id));
   if (added.rows > 0) dispatcher_.ModelAdded(added.rows);
   v1::IngestAck ack;
   ack.set_model_id(request.model_id());

@@ -110,8 +110,7 @@ class CoordinatorService final : public v1::Coordinator::Service {
   BuildRunner builds_;
 
   absl::Mutex rankings_mutex_;
-  std::map<std::string, std::shared_ptr<const Ranking>> rankings_
-      ABSL_GUARDED_BY(rankings_mutex_);
+  std::map<std::string, std::shared_ptr<const Ranking>> rankings_ ABSL_GUARDED_BY(rankings_mutex_);
 };
 
 }  // namespace meshseek

@@ -155,7 +155,9 @@ absl::StatusOr<ModelCounts> CoordinatorStore::CountModels(
           "SUM(failed), SUM(failed = 0 AND indexed) FROM (SELECT MAX(state = 2) AS failed, "
           "MAX(state = 0) AS pending, MIN(state = 1) AND COUNT(*) = ? AS extracted, "
           "MIN(state = 1 AND indexed_codebook = collection || '@' || ?) AND COUNT(*) = ? "
-          "AS indexed FROM models WHERE collection IN (", in, ") GROUP BY model_id)")));
+          "AS indexed FROM models WHERE collection IN (",
+          in,
+          ") GROUP BY model_id)")));
   count.Bind(1, static_cast<int64_t>(collections.size()))
       .Bind(2, build)
       .Bind(3, static_cast<int64_t>(collections.size()));
@@ -187,8 +189,8 @@ absl::Status CoordinatorStore::SetRanking(const std::string& collection,
 absl::StatusOr<std::optional<StoredRanking>> CoordinatorStore::GetRanking(
     const std::string& collection) {
   absl::MutexLock lock(&mutex_);
-  MESHSEEK_ASSIGN_OR_RETURN(
-      Statement select, db_->Prepare("SELECT build, state FROM rankings WHERE collection = ?"));
+  MESHSEEK_ASSIGN_OR_RETURN(Statement select,
+                            db_->Prepare("SELECT build, state FROM rankings WHERE collection = ?"));
   select.Bind(1, collection);
   MESHSEEK_ASSIGN_OR_RETURN(const bool found, select.Step());
   if (!found) return std::nullopt;

@@ -22,22 +22,28 @@ int64_t ToMicros(absl::Time t) { return absl::ToUnixMicros(t); }
 // --------------------------------------------------------------------- models
 
 absl::StatusOr<CoordinatorStore::AddedModel> CoordinatorStore::AddModel(
-    const std::vector<std::string>& collections, const std::string& model_id,
-    const std::string& label, const std::string& mesh, const std::string& job_id) {
+    const std::vector<std::string>& collections,
+    const std::string& model_id,
+    const std::string& label,
+    const std::string& mesh,
+    const std::string& job_id) {
   const std::string fingerprint = MeshFingerprint(mesh);
   absl::MutexLock lock(&mutex_);
   MESHSEEK_ASSIGN_OR_RETURN(Transaction transaction, Transaction::Begin(db_.get()));
   std::optional<AddedModel> result;
   for (const std::string& collection : collections) {
-    MESHSEEK_ASSIGN_OR_RETURN(
-        Statement existing, db_->Prepare("SELECT fingerprint, label, job_id FROM models "
-                                         "WHERE collection = ? AND model_id = ?"));
+    MESHSEEK_ASSIGN_OR_RETURN(Statement existing,
+                              db_->Prepare("SELECT fingerprint, label, job_id FROM models "
+                                           "WHERE collection = ? AND model_id = ?"));
     existing.Bind(1, collection).Bind(2, model_id);
     MESHSEEK_ASSIGN_OR_RETURN(const bool found, existing.Step());
     if (found) {
       if (existing.ColumnText(0) != fingerprint || existing.ColumnText(1) != label) {
         return absl::AlreadyExistsError(
-            absl::StrCat("model ", model_id, " exists in collection '", collection,
+            absl::StrCat("model ",
+                         model_id,
+                         " exists in collection '",
+                         collection,
                          "' with another mesh or label; remove it first"));
       }
       if (!result.has_value()) result = AddedModel{false, existing.ColumnText(2), 0};
@@ -95,8 +101,9 @@ absl::StatusOr<std::optional<absl::Time>> CoordinatorStore::NextRetry(absl::Time
 absl::StatusOr<std::optional<PendingModel>> CoordinatorStore::LoadPending(const ModelKey& key) {
   absl::MutexLock lock(&mutex_);
   MESHSEEK_ASSIGN_OR_RETURN(
-      Statement select, db_->Prepare("SELECT mesh, ordinal, label, attempts, job_id FROM models "
-                                     "WHERE collection = ? AND model_id = ? AND state = 0"));
+      Statement select,
+      db_->Prepare("SELECT mesh, ordinal, label, attempts, job_id FROM models "
+                   "WHERE collection = ? AND model_id = ? AND state = 0"));
   select.Bind(1, key.collection).Bind(2, key.model_id);
   MESHSEEK_ASSIGN_OR_RETURN(const bool found, select.Step());
   if (!found) return std::nullopt;
@@ -122,13 +129,16 @@ absl::StatusOr<bool> CoordinatorStore::MarkExtracted(const ModelKey& key,
   return EndPending(key, ModelState::kExtracted, -1, "", features, feature_count);
 }
 
-absl::StatusOr<bool> CoordinatorStore::MarkFailed(const ModelKey& key, int attempts,
+absl::StatusOr<bool> CoordinatorStore::MarkFailed(const ModelKey& key,
+                                                  int attempts,
                                                   const std::string& reason) {
   return EndPending(key, ModelState::kFailed, attempts, reason, "", 0);
 }
 
-absl::StatusOr<bool> CoordinatorStore::EndPending(const ModelKey& key, ModelState state,
-                                                  int attempts, const std::string& error,
+absl::StatusOr<bool> CoordinatorStore::EndPending(const ModelKey& key,
+                                                  ModelState state,
+                                                  int attempts,
+                                                  const std::string& error,
                                                   const std::string& features,
                                                   uint32_t feature_count) {
   absl::MutexLock lock(&mutex_);
@@ -155,13 +165,14 @@ absl::StatusOr<bool> CoordinatorStore::EndPending(const ModelKey& key, ModelStat
   return true;
 }
 
-absl::Status CoordinatorStore::ScheduleRetry(const ModelKey& key, int attempts,
-                                             absl::Time retry_at, const std::string& error) {
+absl::Status CoordinatorStore::ScheduleRetry(const ModelKey& key,
+                                             int attempts,
+                                             absl::Time retry_at,
+                                             const std::string& error) {
   absl::MutexLock lock(&mutex_);
-  MESHSEEK_ASSIGN_OR_RETURN(
-      Statement update,
-      db_->Prepare("UPDATE models SET attempts = ?, retry_at = ?, error = ? "
-                   "WHERE collection = ? AND model_id = ? AND state = 0"));
+  MESHSEEK_ASSIGN_OR_RETURN(Statement update,
+                            db_->Prepare("UPDATE models SET attempts = ?, retry_at = ?, error = ? "
+                                         "WHERE collection = ? AND model_id = ? AND state = 0"));
   return update.Bind(1, int64_t{attempts})
       .Bind(2, ToMicros(retry_at))
       .Bind(3, error)
@@ -173,17 +184,18 @@ absl::Status CoordinatorStore::ScheduleRetry(const ModelKey& key, int attempts,
 absl::Status CoordinatorStore::MarkIndexed(const ModelKey& key, const std::string& codebook_id) {
   absl::MutexLock lock(&mutex_);
   MESHSEEK_ASSIGN_OR_RETURN(
-      Statement mark, db_->Prepare("UPDATE models SET indexed_codebook = ? WHERE collection = ? "
-                                   "AND model_id = ?"));
+      Statement mark,
+      db_->Prepare("UPDATE models SET indexed_codebook = ? WHERE collection = ? "
+                   "AND model_id = ?"));
   return mark.Bind(1, codebook_id).Bind(2, key.collection).Bind(3, key.model_id).Run();
 }
 
 absl::StatusOr<std::optional<ModelState>> CoordinatorStore::RemoveModel(const ModelKey& key) {
   absl::MutexLock lock(&mutex_);
   MESHSEEK_ASSIGN_OR_RETURN(Transaction transaction, Transaction::Begin(db_.get()));
-  MESHSEEK_ASSIGN_OR_RETURN(
-      Statement erase, db_->Prepare("DELETE FROM models WHERE collection = ? AND model_id = ? "
-                                    "RETURNING state, job_id"));
+  MESHSEEK_ASSIGN_OR_RETURN(Statement erase,
+                            db_->Prepare("DELETE FROM models WHERE collection = ? AND model_id = ? "
+                                         "RETURNING state, job_id"));
   erase.Bind(1, key.collection).Bind(2, key.model_id);
   MESHSEEK_ASSIGN_OR_RETURN(const bool found, erase.Step());
   if (!found) return std::nullopt;
@@ -208,8 +220,11 @@ absl::StatusOr<std::vector<ExtractedModel>> CoordinatorStore::ExtractedModels(
   while (true) {
     MESHSEEK_ASSIGN_OR_RETURN(const bool row, select.Step());
     if (!row) return models;
-    models.push_back({select.ColumnText(0), static_cast<uint64_t>(select.ColumnInt(1)),
-                      select.ColumnText(2), select.ColumnBlob(3), select.ColumnText(4)});
+    models.push_back({select.ColumnText(0),
+                      static_cast<uint64_t>(select.ColumnInt(1)),
+                      select.ColumnText(2),
+                      select.ColumnBlob(3),
+                      select.ColumnText(4)});
   }
 }
 
@@ -253,17 +268,19 @@ absl::StatusOr<v1::ListCollectionModelsResponse> CoordinatorStore::ListModels(
         "SELECT model_id, MIN(label), CASE WHEN MAX(state = 2) THEN 2 WHEN MAX(state = 0) THEN 0 "
         "ELSE 1 END AS merged, MIN(ordinal) AS first, MAX(attempts), GROUP_CONCAT(CASE WHEN "
         "error != '' THEN substr(collection, instr(collection, '~') + 1) || ': ' || error END, "
-        "'; '), SUM(feature_count) FROM models WHERE collection IN (", in, ") GROUP BY model_id "
+        "'; '), SUM(feature_count) FROM models WHERE collection IN (",
+        in,
+        ") GROUP BY model_id "
         "HAVING (?2 < 0 OR merged = ?2) AND first > ?3 ORDER BY first LIMIT ?4");
   } else {
     // Two statements rather than "?2 < 0 OR state = ?2", so that each walks
     // its index in order instead of sorting the collection.
     sql = state < 0 ? "SELECT model_id, label, state, ordinal, attempts, error, "
-                                        "feature_count FROM models WHERE collection = ?1 AND ?2 < "
-                                        "0 AND ordinal > ?3 ORDER BY ordinal LIMIT ?4"
-                                      : "SELECT model_id, label, state, ordinal, attempts, error, "
-                                        "feature_count FROM models WHERE collection = ?1 AND "
-                                        "state = ?2 AND ordinal > ?3 ORDER BY ordinal LIMIT ?4";
+                      "feature_count FROM models WHERE collection = ?1 AND ?2 < "
+                      "0 AND ordinal > ?3 ORDER BY ordinal LIMIT ?4"
+                    : "SELECT model_id, label, state, ordinal, attempts, error, "
+                      "feature_count FROM models WHERE collection = ?1 AND "
+                      "state = ?2 AND ordinal > ?3 ORDER BY ordinal LIMIT ?4";
   }
   MESHSEEK_ASSIGN_OR_RETURN(Statement select, db_->Prepare(sql));
   select.Bind(1, request.collection())

@@ -55,7 +55,8 @@ TEST_F(CoordinatorStoreTest, RefusesANewerSchemaAndAnotherShardCount) {
   }
   auto newer = CoordinatorStore::Open(dir_.string(), 2);
   EXPECT_EQ(newer.status().code(), absl::StatusCode::kFailedPrecondition);
-  EXPECT_THAT(newer.status().message(), HasSubstr(absl::StrCat("schema version ", kCoordinatorSchemaVersion + 1)));
+  EXPECT_THAT(newer.status().message(),
+              HasSubstr(absl::StrCat("schema version ", kCoordinatorSchemaVersion + 1)));
 }
 
 TEST_F(CoordinatorStoreTest, SameModelAgainIsAcknowledgedAnotherIsRefused) {
@@ -223,7 +224,8 @@ TEST_F(CoordinatorStoreTest, FusedMembersHoldEveryModelCountedOnce) {
   ASSERT_NE(store, nullptr);
   v1::PipelineParams other = Params();
   other.set_method(v1::FEATURE_METHOD_RLD);
-  ASSERT_TRUE(store->CreateCollections({{"f", Params()}, {"f~dld", Params()}, {"f~rld", other}}).ok());
+  ASSERT_TRUE(
+      store->CreateCollections({{"f", Params()}, {"f~dld", Params()}, {"f~rld", other}}).ok());
   // All or nothing: a conflict creates none.
   EXPECT_EQ(store->CreateCollections({{"g", Params()}, {"f~rld", Params()}}).code(),
             absl::StatusCode::kAlreadyExists);

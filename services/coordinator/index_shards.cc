@@ -126,8 +126,13 @@ absl::StatusOr<std::vector<IndexShards::Scored>> IndexShards::QueryDistances(
   std::vector<v1::DistancesResponse> answers(shards_.size());
   std::vector<absl::Status> errors(shards_.size());
   ParallelFor(shards_.size(), static_cast<int>(shards_.size()), [&](std::size_t s) {
-    errors[s] = rpc::CallWithRetry(shards_[s].get(), &v1::Index::Stub::Distances, request,
-                                   &answers[s], call_deadline_, retry_, stop_);
+    errors[s] = rpc::CallWithRetry(shards_[s].get(),
+                                   &v1::Index::Stub::Distances,
+                                   request,
+                                   &answers[s],
+                                   call_deadline_,
+                                   retry_,
+                                   stop_);
   });
   std::vector<Scored> all;
   std::size_t not_found = 0;
@@ -142,8 +147,13 @@ absl::StatusOr<std::vector<IndexShards::Scored>> IndexShards::QueryDistances(
     }
     const v1::DistancesResponse& a = answers[s];
     if (a.distances_size() != a.model_ids_size()) {
-      return absl::InternalError(absl::StrCat("index shard ", s, " answered ", a.distances_size(),
-                                              " distances for ", a.model_ids_size(), " models"));
+      return absl::InternalError(absl::StrCat("index shard ",
+                                              s,
+                                              " answered ",
+                                              a.distances_size(),
+                                              " distances for ",
+                                              a.model_ids_size(),
+                                              " models"));
     }
     for (int j = 0; j < a.model_ids_size(); ++j) all.push_back({a.model_ids(j), a.distances(j)});
   }
@@ -185,9 +195,17 @@ absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
       ++found;
     }
     if (found != n || models[p].size() != n) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "collections '", parts[0].collection, "' and '", parts[p].collection, "' hold ", n,
-          " and ", models[p].size(), " models, ", found, " in common; build again"));
+      return absl::FailedPreconditionError(absl::StrCat("collections '",
+                                                        parts[0].collection,
+                                                        "' and '",
+                                                        parts[p].collection,
+                                                        "' hold ",
+                                                        n,
+                                                        " and ",
+                                                        models[p].size(),
+                                                        " models, ",
+                                                        found,
+                                                        " in common; build again"));
     }
   }
 
@@ -225,9 +243,13 @@ absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
       std::size_t covered = 0;
       for (std::size_t s = 0; s < shards_.size(); ++s) {
         v1::DistancesResponse response;
-        const absl::Status status =
-            rpc::CallWithRetry(shards_[s].get(), &v1::Index::Stub::Distances, request, &response,
-                               call_deadline_, retry_, stop_);
+        const absl::Status status = rpc::CallWithRetry(shards_[s].get(),
+                                                       &v1::Index::Stub::Distances,
+                                                       request,
+                                                       &response,
+                                                       call_deadline_,
+                                                       retry_,
+                                                       stop_);
         if (status.code() == absl::StatusCode::kNotFound) continue;
         if (!status.ok()) {
           return absl::Status(status.code(),
@@ -235,9 +257,15 @@ absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
         }
         const std::size_t m = static_cast<std::size_t>(response.model_ids_size());
         if (static_cast<std::size_t>(response.distances_size()) != (end - begin) * m) {
-          return absl::InternalError(absl::StrCat("index shard ", s, " answered ",
-                                                  response.distances_size(), " distances for ",
-                                                  end - begin, " queries and ", m, " models"));
+          return absl::InternalError(absl::StrCat("index shard ",
+                                                  s,
+                                                  " answered ",
+                                                  response.distances_size(),
+                                                  " distances for ",
+                                                  end - begin,
+                                                  " queries and ",
+                                                  m,
+                                                  " models"));
         }
         for (std::size_t j = 0; j < m; ++j) {
           auto it = column.find(response.model_ids(static_cast<int>(j)));
@@ -252,9 +280,14 @@ absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
       }
       if (covered != n) {
         // A model removed (or a shard emptied) between the export and now.
-        return absl::AbortedError(absl::StrCat(
-            "collection '", parts[p].collection, "' changed while its distance matrix was ",
-            "assembled (", covered, " of ", n, " models answered); try again"));
+        return absl::AbortedError(absl::StrCat("collection '",
+                                               parts[p].collection,
+                                               "' changed while its distance matrix was ",
+                                               "assembled (",
+                                               covered,
+                                               " of ",
+                                               n,
+                                               " models answered); try again"));
       }
     }
     for (std::size_t r = begin; r < end; ++r) {

@@ -94,8 +94,7 @@ absl::StatusOr<RankingState> RankingState::Parse(absl::string_view bytes) {
   const auto bad = [](const auto&... what) {
     return absl::DataLossError(absl::StrCat("ranking state: ", what...));
   };
-  if (bytes.size() < sizeof(kMagic) + 8 ||
-      std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
+  if (bytes.size() < sizeof(kMagic) + 8 || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
     return bad("not a ranking state (", bytes.size(), " bytes)");
   }
   const std::size_t body = bytes.size() - 8;
@@ -141,8 +140,8 @@ absl::StatusOr<Ranking> Ranking::Make(std::string build,
                                       RankingState state,
                                       const CollectionOptions& options) {
   if (state.scales.size() != options.methods.size()) {
-    return absl::DataLossError(absl::StrCat("ranking state of ", state.scales.size(),
-                                            " methods for ", options.MethodName()));
+    return absl::DataLossError(absl::StrCat(
+        "ranking state of ", state.scales.size(), " methods for ", options.MethodName()));
   }
   if (options.rerank.enabled() &&
       (!state.graph.has_value() ||
@@ -169,9 +168,13 @@ absl::StatusOr<std::vector<float>> Ranking::RankRow(
   }
   for (const absl::Span<const float>& row : part_rows) {
     if (row.size() != n) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "a row of ", row.size(), " distances for the ", n, " models of build ", build,
-          "; build again"));
+      return absl::FailedPreconditionError(absl::StrCat("a row of ",
+                                                        row.size(),
+                                                        " distances for the ",
+                                                        n,
+                                                        " models of build ",
+                                                        build,
+                                                        "; build again"));
     }
   }
   std::vector<float> fused(n);
@@ -197,8 +200,7 @@ absl::StatusOr<std::vector<v1::ScoredModel>> Ranking::Query(
     }
   }
   std::vector<absl::Span<const float>> spans(rows.begin(), rows.end());
-  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<float> ranked,
-                            RankRow(spans, std::nullopt, options));
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<float> ranked, RankRow(spans, std::nullopt, options));
   std::vector<uint32_t> nodes;
   for (uint32_t i = 0; i < n; ++i) {
     if (answered[i] == part_distances.size()) nodes.push_back(i);  // removed ones are not
@@ -252,7 +254,8 @@ absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index, const Colle
   MESHSEEK_RETURN_IF_ERROR(index->ForEachDistanceRow(
       parts,
       [&](const IndexShards::Row& row) -> absl::Status {
-        for (std::size_t p = 0; p < parts.size(); ++p) scales[p].AddRow(sample[seen], row.distances[p]);
+        for (std::size_t p = 0; p < parts.size(); ++p)
+          scales[p].AddRow(sample[seen], row.distances[p]);
         ++seen;
         return absl::OkStatus();
       },
@@ -265,8 +268,8 @@ absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index, const Colle
     MESHSEEK_ASSIGN_OR_RETURN(state.graph, NeighborGraph::Create(n, options.rerank.graph_k()));
   }
   std::vector<float> fused(n);
-  MESHSEEK_RETURN_IF_ERROR(index->ForEachDistanceRow(
-      parts, [&](const IndexShards::Row& row) -> absl::Status {
+  MESHSEEK_RETURN_IF_ERROR(
+      index->ForEachDistanceRow(parts, [&](const IndexShards::Row& row) -> absl::Status {
         const std::size_t i = state.model_ids.size();
         if (row.distances.front().size() != n || i >= n) {
           return absl::AbortedError("the collection changed during its build; build again");

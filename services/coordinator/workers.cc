@@ -1,8 +1,8 @@
 #include "services/coordinator/workers.h"
 
 #include "absl/strings/str_cat.h"
-#include "common/bof/histogram_weighting.h"
 #include "common/base/status_macros.h"
+#include "common/bof/histogram_weighting.h"
 #include "common/rpc/convert.h"
 
 namespace meshseek {
@@ -22,9 +22,7 @@ std::string MemberCollectionName(const std::string& fused, FeatureMethod method)
   return absl::StrCat(fused, "~", FeatureMethodName(method));
 }
 
-bool IsMemberCollection(const std::string& name) {
-  return name.find('~') != std::string::npos;
-}
+bool IsMemberCollection(const std::string& name) { return name.find('~') != std::string::npos; }
 
 absl::StatusOr<CollectionPlan> LoadCollectionPlan(CoordinatorStore* store,
                                                   const std::string& name) {
@@ -143,9 +141,11 @@ absl::StatusOr<IndexSignature> Workers::Encode(const CollectionInfo& collection,
     return absl::FailedPreconditionError("idf weighting is not served (collection refused)");
   }
   if (weighting.enabled()) {
-    MESHSEEK_RETURN_IF_ERROR(WeightHistogram(
-        weighting, {}, absl::MakeSpan(signature.histogram.mutable_weights()->mutable_data(),
-                                      signature.histogram.weights_size())));
+    MESHSEEK_RETURN_IF_ERROR(
+        WeightHistogram(weighting,
+                        {},
+                        absl::MakeSpan(signature.histogram.mutable_weights()->mutable_data(),
+                                       signature.histogram.weights_size())));
   }
   return signature;
 }
