@@ -179,6 +179,37 @@ std::vector<float> ManifoldRanked(
   return out;
 }
 
+// One result row: the tag, the methods, their weights, the normalisation,
+// the re-ranking `settings` (method,k1,k2,lambda,depth), the metrics and the
+// time; printed and appended to --csv.
+void PrintRow(const std::string& combo,
+              const std::vector<double>& weights,
+              absl::string_view how,
+              const std::string& settings,
+              const RetrievalMetrics& metrics,
+              double seconds) {
+  std::vector<std::string> w;
+  for (double x : weights) w.push_back(absl::StrFormat("%g", x));
+  const std::string row = absl::StrFormat("%s,%s,%s,%s,%s,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f",
+                                          absl::GetFlag(FLAGS_tag),
+                                          combo,
+                                          absl::StrJoin(w, ":"),
+                                          how,
+                                          settings,
+                                          100 * metrics.micro.nn,
+                                          100 * metrics.micro.rp_excl,
+                                          100 * metrics.micro.second_tier,
+                                          100 * metrics.micro.e_measure,
+                                          100 * metrics.micro.dcg,
+                                          100 * metrics.macro.rp_excl,
+                                          seconds);
+  std::printf("%s\n", row.c_str());
+  std::fflush(stdout);
+  if (!absl::GetFlag(FLAGS_csv).empty()) {
+    std::ofstream(absl::GetFlag(FLAGS_csv), std::ios::app) << row << "\n";
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -297,31 +328,17 @@ int main(int argc, char** argv) {
           auto metrics = EvaluateRetrieval(labels, *ranked, absl::GetFlag(FLAGS_threads));
           const double seconds =
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-          std::vector<std::string> w;
-          for (double x : weights) w.push_back(absl::StrFormat("%g", x));
-          const std::string row =
-              absl::StrFormat("%s,%s,%s,%s,%s,%d,%d,%g,%d,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f",
-                              absl::GetFlag(FLAGS_tag),
-                              combo,
-                              absl::StrJoin(w, ":"),
-                              how,
-                              rerank.enabled() ? "kreciprocal" : "none",
-                              rerank.k1,
-                              rerank.k2,
-                              rerank.lambda,
-                              rerank.depth,
-                              100 * metrics->micro.nn,
-                              100 * metrics->micro.rp_excl,
-                              100 * metrics->micro.second_tier,
-                              100 * metrics->micro.e_measure,
-                              100 * metrics->micro.dcg,
-                              100 * metrics->macro.rp_excl,
-                              seconds);
-          std::printf("%s\n", row.c_str());
-          std::fflush(stdout);
-          if (!absl::GetFlag(FLAGS_csv).empty()) {
-            std::ofstream(absl::GetFlag(FLAGS_csv), std::ios::app) << row << "\n";
-          }
+          PrintRow(combo,
+                   weights,
+                   how,
+                   absl::StrFormat("%s,%d,%d,%g,%d",
+                                   rerank.enabled() ? "kreciprocal" : "none",
+                                   rerank.k1,
+                                   rerank.k2,
+                                   rerank.lambda,
+                                   rerank.depth),
+                   *metrics,
+                   seconds);
         }
         if (how != "scale") continue;
         for (absl::string_view pair :
@@ -342,29 +359,12 @@ int main(int argc, char** argv) {
             auto metrics = EvaluateRetrieval(labels, ranked, absl::GetFlag(FLAGS_threads));
             const double seconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            std::vector<std::string> w;
-            for (double x : weights) w.push_back(absl::StrFormat("%g", x));
-            const std::string row = absl::StrFormat(
-                "%s,%s,%s,%s,manifold,%g,%g,%g,0,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f",
-                absl::GetFlag(FLAGS_tag),
-                combo,
-                absl::StrJoin(w, ":"),
-                how,
-                ka[0],
-                ka[1],
-                lambda,
-                100 * metrics->micro.nn,
-                100 * metrics->micro.rp_excl,
-                100 * metrics->micro.second_tier,
-                100 * metrics->micro.e_measure,
-                100 * metrics->micro.dcg,
-                100 * metrics->macro.rp_excl,
-                seconds);
-            std::printf("%s\n", row.c_str());
-            std::fflush(stdout);
-            if (!absl::GetFlag(FLAGS_csv).empty()) {
-              std::ofstream(absl::GetFlag(FLAGS_csv), std::ios::app) << row << "\n";
-            }
+            PrintRow(combo,
+                     weights,
+                     how,
+                     absl::StrFormat("manifold,%g,%g,%g,0", ka[0], ka[1], lambda),
+                     *metrics,
+                     seconds);
           }
         }
       }

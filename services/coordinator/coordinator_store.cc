@@ -128,24 +128,8 @@ absl::Status CoordinatorStore::SetCodebook(const std::string& collection,
 absl::StatusOr<ModelCounts> CoordinatorStore::CountModels(
     const std::vector<std::string>& collections, const std::string& build) {
   absl::MutexLock lock(&mutex_);
-  if (collections.size() == 1) {
-    // One collection: one pass over its rows (the primary key's range).
-    MESHSEEK_ASSIGN_OR_RETURN(
-        Statement count,
-        db_->Prepare("SELECT COUNT(*), SUM(state = 0), SUM(state = 1), SUM(state = 2), "
-                     "SUM(state = 1 AND indexed_codebook = collection || '@' || ?) "
-                     "FROM models WHERE collection = ?"));
-    count.Bind(1, build).Bind(2, collections.front());
-    MESHSEEK_RETURN_IF_ERROR(count.Run());
-    ModelCounts counts;
-    counts.models = count.ColumnInt(0);
-    counts.pending = count.ColumnInt(1);
-    counts.extracted = count.ColumnInt(2);
-    counts.failed = count.ColumnInt(3);
-    counts.indexed = build.empty() ? 0 : count.ColumnInt(4);
-    return counts;
-  }
-  // A fused collection's members: each model once, over all its rows.
+  // Each model once over all its rows (one, or one per member of a fused
+  // collection): extracted and indexed only when it is in every one.
   std::string in;
   for (std::size_t i = 0; i < collections.size(); ++i) absl::StrAppend(&in, i ? ", ?" : "?");
   MESHSEEK_ASSIGN_OR_RETURN(
