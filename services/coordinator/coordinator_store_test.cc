@@ -7,7 +7,10 @@
 
 #include "absl/time/clock.h"
 #include "common/base/hash.h"
+#include "common/pipeline/retrieval_pipeline.h"
+#include "common/rpc/convert.h"
 #include "common/store/sqlite_db.h"
+#include "services/coordinator/workers.h"
 
 namespace meshseek {
 namespace {
@@ -286,6 +289,28 @@ TEST_F(CoordinatorStoreTest, RankingStateIsReplacedByTheNextBuild) {
   ASSERT_TRUE(got.has_value());
   EXPECT_EQ(got->build, "build-2");
   EXPECT_EQ(got->state, "two");
+}
+
+// A collection stored before histograms could be weighted has no
+// histogram_power among its (otherwise complete) parameters: it keeps ranking
+// unweighted, as its index was built, though LSF's default is now 0.5.
+TEST_F(CoordinatorStoreTest, ACollectionStoredBeforeWeightingKeepsUnweightedHistograms) {
+  auto store = OpenStore();
+  v1::PipelineParams params;
+  rpc::PipelineParamsToProto(RetrievalPipelineOptions::ForMethod(FeatureMethod::kLsf), &params);
+  ASSERT_TRUE(store->CreateCollections({{"now", params}}).ok());
+  v1::PipelineParams legacy;
+  for (const v1::ParamValue& v : params.values()) {
+    if (v.name() != "histogram_power") *legacy.add_values() = v;
+  }
+  ASSERT_EQ(legacy.values_size() + 1, params.values_size());
+  ASSERT_TRUE(store->CreateCollections({{"before", legacy}}).ok());
+  auto now = LoadCollectionPlan(store.get(), "now");
+  auto before = LoadCollectionPlan(store.get(), "before");
+  ASSERT_TRUE(now.ok() && before.ok());
+  EXPECT_EQ(now->options.methods[0].weighting.power, 0.5);
+  EXPECT_EQ(before->options.methods[0].weighting.power, 1.0);
+  EXPECT_FALSE(before->parts[0].options.weighting.enabled());
 }
 
 }  // namespace

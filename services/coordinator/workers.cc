@@ -1,5 +1,8 @@
 #include "services/coordinator/workers.h"
 
+#include <algorithm>
+
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "common/base/status_macros.h"
 #include "common/bof/histogram_weighting.h"
@@ -33,6 +36,18 @@ absl::StatusOr<CollectionPlan> LoadCollectionPlan(CoordinatorStore* store,
   plan.codebook_id = std::move(stored.codebook_id);
   plan.member = IsMemberCollection(name);
   MESHSEEK_ASSIGN_OR_RETURN(plan.options, rpc::CollectionOptionsFromParams(plan.params));
+  // Stored parameters are complete, so one without histogram_power was
+  // created before histograms could be weighted: its index holds them
+  // unweighted, and so must its queries be (LSF's default is 0.5 now).
+  const bool before_weighting =
+      std::none_of(plan.params.values().begin(), plan.params.values().end(),
+                   [](const v1::ParamValue& v) {
+                     // "histogram_power", or a fused collection's "lsf.histogram_power".
+                     return absl::EndsWith(v.name(), "histogram_power");
+                   });
+  if (before_weighting) {
+    for (RetrievalPipelineOptions& method : plan.options.methods) method.weighting = {};
+  }
   if (!plan.fused()) {
     CollectionInfo part;
     part.name = name;
