@@ -241,8 +241,6 @@ void BuildRunner::Run(const std::string& job_id, const std::string& collection) 
   const std::string codebook_id = absl::StrCat(collection, "@", job_id);
   if (plan->options.rescaled()) {
     const absl::Time start = absl::Now();
-    for (CollectionInfo& part : plan->parts)
-      part.codebook_id = absl::StrCat(part.name, "@", job_id);
     absl::StatusOr<RankingState> state = ComputeRankingState(workers_->index(), *plan);
     if (*stop_) return Done(collection);
     if (!state.ok()) return fail(Prefixed(state.status(), "ranking: "));

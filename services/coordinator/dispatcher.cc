@@ -121,8 +121,7 @@ bool Dispatcher::Claim(ModelKey* key) {
 void Dispatcher::Process(const ModelKey& key) {
   // Models live in collections of one method (a fused collection's members).
   absl::StatusOr<CollectionPlan> plan = LoadCollectionPlan(store_, key.collection);
-  absl::StatusOr<CollectionInfo> info =
-      plan.ok() ? LoadCollection(store_, key.collection) : plan.status();
+  absl::StatusOr<CollectionInfo> info = plan.ok() ? OnlyPart(*plan) : plan.status();
   absl::StatusOr<std::optional<PendingModel>> pending = store_->LoadPending(key);
   if (!pending.ok()) {
     MESHSEEK_LOG(ERROR) << "coordinator: model " << key.model_id << ": " << pending.status();

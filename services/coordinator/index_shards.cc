@@ -67,27 +67,39 @@ absl::StatusOr<bool> IndexShards::Remove(const std::string& collection,
   return response.removed();
 }
 
-absl::StatusOr<std::vector<v1::ScoredModel>> IndexShards::Search(const v1::SearchRequest& request) {
-  std::vector<v1::SearchResponse> answers(shards_.size());
+template <typename Response, typename Request, typename Method>
+absl::StatusOr<std::vector<std::optional<Response>>> IndexShards::AskEveryShard(
+    Method method, const Request& request) {
+  std::vector<Response> answers(shards_.size());
   std::vector<absl::Status> errors(shards_.size());
   ParallelFor(shards_.size(), static_cast<int>(shards_.size()), [&](std::size_t s) {
-    errors[s] = rpc::CallWithRetry(shards_[s].get(), &v1::Index::Stub::Search, request, &answers[s],
-                                   call_deadline_, retry_, stop_);
+    errors[s] = rpc::CallWithRetry(
+        shards_[s].get(), method, request, &answers[s], call_deadline_, retry_, stop_);
   });
-  std::vector<v1::ScoredModel> merged;
+  std::vector<std::optional<Response>> found(shards_.size());
   std::size_t not_found = 0;
   for (std::size_t s = 0; s < shards_.size(); ++s) {
     if (errors[s].code() == absl::StatusCode::kNotFound) {
       ++not_found;
-      continue;
-    }
-    if (!errors[s].ok()) {
+    } else if (!errors[s].ok()) {
       return absl::Status(errors[s].code(),
                           absl::StrCat("index shard ", s, ": ", errors[s].message()));
+    } else {
+      found[s] = std::move(answers[s]);
     }
-    for (v1::ScoredModel& m : *answers[s].mutable_results()) merged.push_back(std::move(m));
   }
   if (not_found == shards_.size()) return errors[0];
+  return found;
+}
+
+absl::StatusOr<std::vector<v1::ScoredModel>> IndexShards::Search(const v1::SearchRequest& request) {
+  MESHSEEK_ASSIGN_OR_RETURN(std::vector<std::optional<v1::SearchResponse>> answers,
+                            AskEveryShard<v1::SearchResponse>(&v1::Index::Stub::Search, request));
+  std::vector<v1::ScoredModel> merged;
+  for (std::optional<v1::SearchResponse>& answer : answers) {
+    if (!answer.has_value()) continue;
+    for (v1::ScoredModel& m : *answer->mutable_results()) merged.push_back(std::move(m));
+  }
   std::sort(merged.begin(), merged.end(), [](const v1::ScoredModel& a, const v1::ScoredModel& b) {
     return std::make_tuple(a.distance(), a.ordinal(), std::cref(a.model_id())) <
            std::make_tuple(b.distance(), b.ordinal(), std::cref(b.model_id()));
@@ -123,29 +135,13 @@ absl::StatusOr<std::vector<v1::IndexedModel>> IndexShards::Export(std::size_t s,
 
 absl::StatusOr<std::vector<IndexShards::Scored>> IndexShards::QueryDistances(
     const v1::DistancesRequest& request) {
-  std::vector<v1::DistancesResponse> answers(shards_.size());
-  std::vector<absl::Status> errors(shards_.size());
-  ParallelFor(shards_.size(), static_cast<int>(shards_.size()), [&](std::size_t s) {
-    errors[s] = rpc::CallWithRetry(shards_[s].get(),
-                                   &v1::Index::Stub::Distances,
-                                   request,
-                                   &answers[s],
-                                   call_deadline_,
-                                   retry_,
-                                   stop_);
-  });
+  MESHSEEK_ASSIGN_OR_RETURN(
+      const std::vector<std::optional<v1::DistancesResponse>> answers,
+      AskEveryShard<v1::DistancesResponse>(&v1::Index::Stub::Distances, request));
   std::vector<Scored> all;
-  std::size_t not_found = 0;
-  for (std::size_t s = 0; s < shards_.size(); ++s) {
-    if (errors[s].code() == absl::StatusCode::kNotFound) {
-      ++not_found;
-      continue;
-    }
-    if (!errors[s].ok()) {
-      return absl::Status(errors[s].code(),
-                          absl::StrCat("index shard ", s, ": ", errors[s].message()));
-    }
-    const v1::DistancesResponse& a = answers[s];
+  for (std::size_t s = 0; s < answers.size(); ++s) {
+    if (!answers[s].has_value()) continue;
+    const v1::DistancesResponse& a = *answers[s];
     if (a.distances_size() != a.model_ids_size()) {
       return absl::InternalError(absl::StrCat("index shard ",
                                               s,
@@ -157,7 +153,6 @@ absl::StatusOr<std::vector<IndexShards::Scored>> IndexShards::QueryDistances(
     }
     for (int j = 0; j < a.model_ids_size(); ++j) all.push_back({a.model_ids(j), a.distances(j)});
   }
-  if (not_found == shards_.size()) return errors[0];
   return all;
 }
 

@@ -19,6 +19,7 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -93,6 +94,12 @@ class IndexShards {
   // Every model of `collection` on shard s (empty when it has none).
   absl::StatusOr<std::vector<v1::IndexedModel>> Export(std::size_t s,
                                                        const std::string& collection);
+  // Calls `method` on every shard at once; shard s's answer, or nullopt when
+  // it does not hold the collection (NotFound). NotFound from every shard is
+  // the result; any other error names its shard.
+  template <typename Response, typename Request, typename Method>
+  absl::StatusOr<std::vector<std::optional<Response>>> AskEveryShard(Method method,
+                                                                     const Request& request);
 
   std::vector<std::unique_ptr<v1::Index::Stub>> shards_;
   const absl::Duration call_deadline_;

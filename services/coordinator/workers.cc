@@ -70,13 +70,12 @@ absl::StatusOr<CollectionPlan> LoadCollectionPlan(CoordinatorStore* store,
   return plan;
 }
 
-absl::StatusOr<CollectionInfo> LoadCollection(CoordinatorStore* store, const std::string& name) {
-  MESHSEEK_ASSIGN_OR_RETURN(CollectionPlan plan, LoadCollectionPlan(store, name));
+absl::StatusOr<CollectionInfo> OnlyPart(const CollectionPlan& plan) {
   if (plan.fused()) {
     return absl::FailedPreconditionError(
-        absl::StrCat("collection '", name, "' fuses ", plan.options.MethodName()));
+        absl::StrCat("collection '", plan.name, "' fuses ", plan.options.MethodName()));
   }
-  return std::move(plan.parts.front());
+  return plan.parts.front();
 }
 
 Workers::Workers(const CoordinatorOptions& options, const std::atomic<bool>* stop)

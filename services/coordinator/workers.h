@@ -66,7 +66,7 @@ bool IsMemberCollection(const std::string& name);
 absl::StatusOr<CollectionPlan> LoadCollectionPlan(CoordinatorStore* store, const std::string& name);
 /// A collection of one method (or a member): its one part.
 /// FailedPrecondition for a fused collection.
-absl::StatusOr<CollectionInfo> LoadCollection(CoordinatorStore* store, const std::string& name);
+absl::StatusOr<CollectionInfo> OnlyPart(const CollectionPlan& plan);
 
 /// What the index ranks a model by: its histogram over a codebook (bag of
 /// features), or its descriptor (a global method: no codebook).
