@@ -30,6 +30,7 @@
 #include "common/features/local_feature_extractor.h"
 #include "common/geometry/mesh_io.h"
 #include "common/geometry/test_meshes.h"
+#include "common/render/thumbnail.h"
 
 ABSL_FLAG(std::string, models_dir, "", "folder of meshes to time (recursive)");
 ABSL_FLAG(int, max_models, 20, "time at most this many models (the first by path)");
@@ -102,6 +103,33 @@ void RegisterMethodBenchmarks() {
         ->Iterations(1);
   }
 }
+
+// What ingest adds per model: the coordinator draws each model's thumbnail.
+void BM_Thumbnail(benchmark::State& state) {
+  const std::vector<TriangleMesh>& meshes = Models();
+  std::vector<double> per_model_ms;
+  double bytes = 0;
+  for (auto _ : state) {
+    for (const TriangleMesh& mesh : meshes) {
+      const auto start = std::chrono::steady_clock::now();
+      auto png = RenderThumbnailPng(mesh);
+      per_model_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count());
+      if (!png.ok()) {
+        state.SkipWithError(std::string(png.status().message()).c_str());
+        return;
+      }
+      bytes += png->size();
+    }
+  }
+  std::sort(per_model_ms.begin(), per_model_ms.end());
+  state.counters["models"] = static_cast<double>(meshes.size());
+  state.counters["median_ms_per_model"] = per_model_ms[per_model_ms.size() / 2];
+  state.counters["p90_ms_per_model"] = per_model_ms[per_model_ms.size() * 9 / 10];
+  state.counters["mean_png_bytes"] = bytes / per_model_ms.size();
+}
+BENCHMARK(BM_Thumbnail)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 void BM_ExtractRldSamples(benchmark::State& state) {
   ExtractorOptions options = BaseOptions();

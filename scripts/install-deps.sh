@@ -14,10 +14,15 @@ PACKAGES=(
   libflann-dev liblz4-dev                            # k-nearest-neighbour graph (RLD-SIFT)
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # services
   libsqlite3-dev                                     # state of the stateful services
+  prometheus-cpp-dev                                 # the services' Prometheus metrics (/metrics over HTTP)
+  libcpp-httplib-dev                                 # the web gateway's HTTP server (meshseek web)
 )
 if [ "${1:-}" != "--build-only" ]; then
   PACKAGES+=(
     ccache python3                                   # faster rebuilds; python3 runs the reference evaluator
+    python3-grpcio python3-protobuf                  # the Python client (python/) and its test
+    chromium                                         # the web page's browser test (tests/web_browser_test.py)
+    python3-websocket                                # ... drives headless Chromium over the DevTools protocol
     openssl                                          # tests/security_test makes a throwaway CA (deploy/make-certs.sh)
     libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
     libfaiss-dev libopenblas-dev                     # yardsticks of bench/codebook_benchmark (Faiss on OpenBLAS)

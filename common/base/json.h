@@ -1,7 +1,8 @@
 // A small JSON value for writing reports (metrics.json and friends).
 //
 // Objects keep insertion order so that files diff cleanly. Only writing is
-// supported: meshseek reads no JSON. Non-finite numbers are written as null,
+// supported here; the evaluation report reads back the metrics.json that eval
+// wrote with common/eval/flat_json.h. Non-finite numbers are written as null,
 // since JSON has no NaN.
 #ifndef MESHSEEK_COMMON_BASE_JSON_H_
 #define MESHSEEK_COMMON_BASE_JSON_H_

@@ -11,16 +11,14 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "common/base/parallel.h"
+#include "common/base/status_macros.h"
 #include "common/eval/class_file.h"
 
 namespace meshseek {
 namespace {
 
 // Field order of the reports, and the keys psb_eval.py uses for them.
-constexpr struct {
-  const char* key;
-  double RetrievalScores::*field;
-} kColumns[] = {
+constexpr ScoreColumn kColumns[] = {
     {"NN", &RetrievalScores::nn},
     {"FT", &RetrievalScores::first_tier},
     {"ST", &RetrievalScores::second_tier},
@@ -53,15 +51,7 @@ RetrievalScores ScoreQuery(std::size_t q,
                            const std::vector<float>& distances,
                            const std::vector<double>& discount) {
   const std::size_t n = label_id.size();
-  const float* row = distances.data() + q * n;
-  // Sorting (distance, index) pairs gives psb_eval.py's tie rule for free
-  // and keeps the comparisons on contiguous memory.
-  std::vector<std::pair<float, uint32_t>> ranking;
-  ranking.reserve(n - 1);
-  for (std::size_t j = 0; j < n; ++j) {
-    if (j != q) ranking.emplace_back(row[j], static_cast<uint32_t>(j));
-  }
-  std::sort(ranking.begin(), ranking.end());
+  const std::vector<std::pair<float, uint32_t>> ranking = RankOthers(distances, n, q);
 
   const std::size_t k = class_size - 1;
   const std::size_t top = std::min<std::size_t>(32, n - 1);
@@ -92,9 +82,28 @@ RetrievalScores ScoreQuery(std::size_t q,
 
 }  // namespace
 
-absl::StatusOr<RetrievalMetrics> EvaluateRetrieval(const std::vector<std::string>& labels,
-                                                   const std::vector<float>& distances,
-                                                   int num_threads) {
+absl::Span<const ScoreColumn> ScoreColumns() { return kColumns; }
+
+std::vector<std::pair<float, uint32_t>> RankOthers(const std::vector<float>& distances,
+                                                   std::size_t n,
+                                                   std::size_t q,
+                                                   std::size_t top) {
+  const float* row = distances.data() + q * n;
+  // Sorting (distance, index) pairs gives psb_eval.py's tie rule for free
+  // and keeps the comparisons on contiguous memory.
+  std::vector<std::pair<float, uint32_t>> ranking;
+  ranking.reserve(n - 1);
+  for (std::size_t j = 0; j < n; ++j) {
+    if (j != q) ranking.emplace_back(row[j], static_cast<uint32_t>(j));
+  }
+  top = std::min(top, ranking.size());
+  std::partial_sort(ranking.begin(), ranking.begin() + top, ranking.end());
+  ranking.resize(top);
+  return ranking;
+}
+
+absl::StatusOr<QueryClasses> ClassifyQueries(const std::vector<std::string>& labels,
+                                             const std::vector<float>& distances) {
   const std::size_t n = labels.size();
   if (n == 0) return absl::InvalidArgumentError("no models to evaluate (empty label list)");
   if (n > std::numeric_limits<uint32_t>::max() || distances.size() / n != n ||
@@ -109,11 +118,13 @@ absl::StatusOr<RetrievalMetrics> EvaluateRetrieval(const std::vector<std::string
     }
   }
 
-  // Integer class ids, so the inner loop compares ints rather than strings.
+  // Integer class ids, so that evaluators compare ints rather than strings.
+  QueryClasses classes;
   std::unordered_map<std::string, int> id_of_label;
-  std::vector<std::string> names;
-  std::vector<std::size_t> size_of;
-  std::vector<int> label_id(n);
+  std::vector<std::string>& names = classes.names;
+  std::vector<std::size_t>& size_of = classes.sizes;
+  std::vector<int>& label_id = classes.class_of;
+  label_id.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     if (labels[i].empty()) {
       return absl::InvalidArgumentError(absl::StrCat("model ", i, " has an empty class label"));
@@ -127,7 +138,7 @@ absl::StatusOr<RetrievalMetrics> EvaluateRetrieval(const std::vector<std::string
     ++size_of[it->second];
   }
 
-  std::vector<std::size_t> queries;
+  std::vector<std::size_t>& queries = classes.queries;
   for (std::size_t i = 0; i < n; ++i) {
     if (labels[i] != kMiscClass && size_of[label_id[i]] > 2) queries.push_back(i);
   }
@@ -140,6 +151,19 @@ absl::StatusOr<RetrievalMetrics> EvaluateRetrieval(const std::vector<std::string
                                                    kMiscClass,
                                                    "')"));
   }
+
+  return classes;
+}
+
+absl::StatusOr<RetrievalMetrics> EvaluateRetrieval(const std::vector<std::string>& labels,
+                                                   const std::vector<float>& distances,
+                                                   int num_threads) {
+  MESHSEEK_ASSIGN_OR_RETURN(const QueryClasses classes, ClassifyQueries(labels, distances));
+  const std::size_t n = labels.size();
+  const std::vector<std::string>& names = classes.names;
+  const std::vector<std::size_t>& size_of = classes.sizes;
+  const std::vector<int>& label_id = classes.class_of;
+  const std::vector<std::size_t>& queries = classes.queries;
 
   std::vector<double> discount(n);
   for (std::size_t r = 0; r < n; ++r) discount[r] = r == 0 ? 1.0 : 1.0 / std::log2(r + 1.0);

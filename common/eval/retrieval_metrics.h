@@ -26,11 +26,13 @@
 #define MESHSEEK_COMMON_EVAL_RETRIEVAL_METRICS_H_
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/types/span.h"
 #include "common/base/json.h"
 
 namespace meshseek {
@@ -62,6 +64,35 @@ struct RetrievalMetrics {
   std::vector<std::pair<std::string, RetrievalScores>> per_class;
   std::vector<QueryScores> per_query;  // in model order
 };
+
+// A metric's key (as metrics.json and psb_eval.py name it) and its field, in
+// the reports' column order: NN, FT, ST, E, DCG, RP_excl, RP_incl.
+struct ScoreColumn {
+  const char* key;
+  double RetrievalScores::*field;
+};
+absl::Span<const ScoreColumn> ScoreColumns();
+
+// The classes of a labelled N x N distance matrix and which models are
+// queries (DESIGN.md 3.2: not misc, of a class with more than 2 models):
+// what every evaluation of a ranking starts from.
+struct QueryClasses {
+  std::vector<std::string> names;    // classes in order of their first model
+  std::vector<std::size_t> sizes;    // models per class
+  std::vector<int> class_of;         // per model, an index into names
+  std::vector<std::size_t> queries;  // query models, ascending
+};
+// Errors as EvaluateRetrieval's below.
+absl::StatusOr<QueryClasses> ClassifyQueries(const std::vector<std::string>& labels,
+                                             const std::vector<float>& distances);
+
+// Model q's ranking of the other models of an N x N matrix: (distance,
+// index) pairs, nearest first, ties by index (psb_eval.py's rule). Only the
+// first `top` are sorted (and returned) when fewer are wanted.
+std::vector<std::pair<float, uint32_t>> RankOthers(const std::vector<float>& distances,
+                                                   std::size_t n,
+                                                   std::size_t q,
+                                                   std::size_t top = SIZE_MAX);
 
 // Evaluates leave-one-out retrieval. `labels[i]` is model i's class and
 // `distances` the N x N row-major matrix (entry i*N+j = distance from query i

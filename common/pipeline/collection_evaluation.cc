@@ -139,6 +139,17 @@ absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
   }
   MESHSEEK_RETURN_IF_ERROR(WriteDistanceMatrix(
       out_dir + "/distances.bin", evaluation.distances, evaluation.models.size()));
+  // The models in matrix order with absolute paths, so that `meshseek report`
+  // can label the rows and find the meshes from any working folder.
+  std::vector<ManifestEntry> models = evaluation.models;
+  for (ManifestEntry& m : models) {
+    m.path = std::filesystem::absolute(m.path, ec).lexically_normal().string();
+    if (ec) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(m.path, ": cannot make the path absolute (", ec.message(), ")"));
+    }
+  }
+  MESHSEEK_RETURN_IF_ERROR(WriteManifest(out_dir + "/models.csv", models));
   if (evaluation.methods.size() > 1) {
     // Each method's own matrix beside the fused one: the ablation's input
     // (bench/fusion_sweep) without extracting again.

@@ -54,7 +54,9 @@ absl::StatusOr<std::vector<float>> CombineMethodDistances(
 absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<ManifestEntry>& models,
                                                         const CollectionOptions& options);
 
-// Writes DIR/distances.bin (PSB float32 matrix, manifest order), for a
+// Writes DIR/distances.bin (PSB float32 matrix, manifest order),
+// DIR/models.csv (the models as a manifest, id,class,path, in matrix order
+// with absolute paths: what `meshseek report` reads), for a
 // collection of several methods each one's own as DIR/distances.METHOD.bin
 // (when evaluated in process), and DIR/metrics.json (every metric, micro and macro, per class, the
 // parameters, feature counts, each method's scale and the stage timings). Creates DIR.

@@ -123,6 +123,16 @@ TEST(EvaluateCollectionTest, AFusedCollectionCombinesItsMethodsEvaluatedAlone) {
                           "\"rerank_k1\": 4"}) {
     EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
   }
+  // The models in matrix order, with absolute paths, for `meshseek report`.
+  auto listed = ReadManifest(dir + "/eval/models.csv");
+  ASSERT_TRUE(listed.ok()) << listed.status();
+  ASSERT_EQ(listed->size(), models->size());
+  for (std::size_t i = 0; i < models->size(); ++i) {
+    EXPECT_EQ((*listed)[i].id, (*models)[i].id);
+    EXPECT_EQ((*listed)[i].label, (*models)[i].label);
+    EXPECT_TRUE(std::filesystem::path((*listed)[i].path).is_absolute()) << (*listed)[i].path;
+    EXPECT_TRUE(std::filesystem::equivalent((*listed)[i].path, (*models)[i].path));
+  }
   // Each method's own matrix beside the fused one, for the ablation.
   for (std::size_t m = 0; m < 2; ++m) {
     const std::string method(FeatureMethodName(fused->methods[m].method));

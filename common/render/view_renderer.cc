@@ -74,6 +74,7 @@ ViewImage ViewRenderer::Render(const ViewCamera& frame) const {
   image.size = n;
   image.depth.assign(static_cast<std::size_t>(n) * n, 0.0f);
   image.mask.assign(static_cast<std::size_t>(n) * n, 0);
+  if (options_.record_faces) image.face.assign(static_cast<std::size_t>(n) * n, -1);
   // Screen position (pixel units, centres at k + 0.5) and depth per vertex.
   struct Projected {
     double x, y, z;
@@ -110,6 +111,7 @@ ViewImage ViewRenderer::Render(const ViewCamera& frame) const {
         if (image.mask[at] == 0 || z > image.depth[at]) {
           image.depth[at] = z;
           image.mask[at] = 1;
+          if (!image.face.empty()) image.face[at] = static_cast<int32_t>(&t - triangles_.data());
         }
       }
     }

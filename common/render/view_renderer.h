@@ -37,6 +37,10 @@ struct ViewRenderOptions {
   /// Half-width of the view window relative to the enclosing sphere's radius
   /// (1: the sphere just fits; larger leaves a margin). In (0, 16].
   double window_scale = 1.0;
+  /// Also record which triangle each pixel shows (ViewImage::face): what a
+  /// shaded picture needs (thumbnail.h); off for descriptors, which need
+  /// only depth and silhouette.
+  bool record_faces = false;
 
   absl::Status Validate() const;
 };
@@ -48,6 +52,9 @@ struct ViewImage {
   std::vector<float> depth;
   /// 1 where the model covers the pixel: the silhouette.
   std::vector<uint8_t> mask;
+  /// The visible triangle's index per pixel, -1 where the model is not; only
+  /// with ViewRenderOptions::record_faces, empty otherwise.
+  std::vector<int32_t> face;
 
   float DepthAt(int x, int y) const { return depth[static_cast<std::size_t>(y) * size + x]; }
   bool Covered(int x, int y) const { return mask[static_cast<std::size_t>(y) * size + x] != 0; }

@@ -114,7 +114,9 @@ TEST(ViewRendererTest, BoxMatchesAnalyticDepthAlongTheAxes) {
           ASSERT_TRUE(image.Covered(x, y));
           EXPECT_NEAR(image.DepthAt(x, y), expected, 1e-6);
         }
-        if (out) ASSERT_FALSE(image.Covered(x, y)) << x << "," << y;
+        if (out) {
+          ASSERT_FALSE(image.Covered(x, y)) << x << "," << y;
+        }
       }
     }
     EXPECT_GT(inside, 100);

@@ -7,6 +7,7 @@
 #include <signal.h>
 
 #include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/synchronization/mutex.h"
 #include "common/base/logging.h"
@@ -117,6 +118,14 @@ class AdmissionInterceptorFactory final
   std::shared_ptr<AdmissionGate> gate_;
 };
 
+// The port of host:port, or -1 when there is none.
+int PortOf(const std::string& address) {
+  const std::size_t colon = address.rfind(':');
+  int port = -1;
+  if (colon == std::string::npos || !absl::SimpleAtoi(address.substr(colon + 1), &port)) return -1;
+  return port;
+}
+
 }  // namespace
 
 absl::Status ServerOptions::Validate() const {
@@ -140,6 +149,15 @@ absl::Status ServerOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("health address must be host:port, got '", health_address, "'"));
   }
+  if (!metrics_address.empty()) {
+    const int port = PortOf(metrics_address);
+    if (port < 0 || port > 65535 || (port != 0 && port == PortOf(address))) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "metrics address must be host:port with a port other than the server's, got '",
+          metrics_address,
+          "'"));
+    }
+  }
   if (absl::Status secure = security.Validate(); !secure.ok()) return secure;
   if (grace_period < absl::ZeroDuration() || max_connection_age < absl::Seconds(1)) {
     return absl::InvalidArgumentError("grace period must be >= 0 and connection age >= 1 s");
@@ -158,6 +176,15 @@ absl::StatusOr<std::unique_ptr<RpcServer>> RpcServer::Start(
   std::unique_ptr<RpcServer> server(new RpcServer());
   server->name_ = name;
   server->options_ = options;
+  if (!options.metrics_address.empty()) {
+    absl::StatusOr<std::unique_ptr<MetricsEndpoint>> metrics =
+        MetricsEndpoint::Start(options.metrics_address);
+    if (!metrics.ok()) {
+      return absl::Status(metrics.status().code(),
+                          absl::StrCat(name, ": ", metrics.status().message()));
+    }
+    server->metrics_ = *std::move(metrics);
+  }
   absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials =
       MakeServerCredentials(options.security);
   if (!credentials.ok()) {
@@ -174,6 +201,7 @@ absl::StatusOr<std::unique_ptr<RpcServer>> RpcServer::Start(
   quota.SetMaxThreads(options.max_threads + options.max_queued_calls + 1);
   builder.SetResourceQuota(quota);
   std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
+  interceptors.push_back(MetricsInterceptorFactory(name));
   interceptors.push_back(std::make_unique<AdmissionInterceptorFactory>(
       std::make_shared<AdmissionGate>(options.max_threads, options.max_queued_calls)));
   builder.experimental().SetInterceptorCreators(std::move(interceptors));
@@ -207,13 +235,15 @@ absl::StatusOr<std::unique_ptr<RpcServer>> RpcServer::Start(
     server->health_server_->GetHealthCheckService()->SetServingStatus(true);
   }
   server->server_->GetHealthCheckService()->SetServingStatus(true);
-  MESHSEEK_LOG(INFO) << name << ": serving on port " << server->port_
-                     << (options.security.tls_enabled() ? " (TLS" : " (plaintext")
-                     << (options.security.tls.ca_file.empty() ? "" : ", client certificates required")
-                     << (options.security.token_file.empty() ? "" : ", bearer token required") << ")"
-                     << (server->health_port_ != 0
-                             ? absl::StrCat(", health on port ", server->health_port_)
-                             : std::string());
+  MESHSEEK_LOG(INFO)
+      << name << ": serving on port " << server->port_
+      << (options.security.tls_enabled() ? " (TLS" : " (plaintext")
+      << (options.security.tls.ca_file.empty() ? "" : ", client certificates required")
+      << (options.security.token_file.empty() ? "" : ", bearer token required") << ")"
+      << (server->health_port_ != 0 ? absl::StrCat(", health on port ", server->health_port_)
+                                    : std::string())
+      << (server->metrics_ != nullptr ? absl::StrCat(", metrics on port ", server->metrics_->port())
+                                      : std::string());
   return server;
 }
 

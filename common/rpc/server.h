@@ -18,7 +18,9 @@
 //   - a maximum connection age, so clients re-resolve DNS and find new
 //     replicas;
 //   - graceful shutdown: NOT_SERVING, stop taking calls, let in-flight calls
-//     finish within the grace period, then cancel them.
+//     finish within the grace period, then cancel them;
+//   - Prometheus metrics (metrics.h): every call counted by method and status
+//     and timed, served over HTTP when `metrics_address` is set.
 #ifndef MESHSEEK_COMMON_RPC_SERVER_H_
 #define MESHSEEK_COMMON_RPC_SERVER_H_
 
@@ -32,6 +34,7 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "common/rpc/credentials.h"
+#include "common/rpc/metrics.h"
 
 namespace meshseek::rpc {
 
@@ -61,6 +64,12 @@ struct ServerOptions {
   /// host:port of a plaintext port that serves grpc.health.v1 only (and
   /// mirrors the main port's serving status); empty: none. Port 0 picks one.
   std::string health_address;
+  /// host:port of a plaintext HTTP endpoint serving the process's Prometheus
+  /// metrics at /metrics (metrics.h); empty: none. Calls are counted either
+  /// way, into one registry per process, so one endpoint covers every server
+  /// of the process (the embedded stack gives it to one of its five). Port 0
+  /// picks a free port.
+  std::string metrics_address;
 
   absl::Status Validate() const;
 };
@@ -78,6 +87,8 @@ class RpcServer {
   int port() const { return port_; }
   /// The bound health-only port; 0 when there is none.
   int health_port() const { return health_port_; }
+  /// The bound metrics port; 0 when there is none.
+  int metrics_port() const { return metrics_ ? metrics_->port() : 0; }
   /// Graceful shutdown as described above; idempotent.
   void Shutdown();
 
@@ -87,6 +98,7 @@ class RpcServer {
   ServerOptions options_;
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<grpc::Server> health_server_;
+  std::unique_ptr<MetricsEndpoint> metrics_;
   int port_ = 0;
   int health_port_ = 0;
   bool shut_down_ = false;

@@ -21,6 +21,10 @@ ABSL_FLAG(std::string, tls_ca, "",
 ABSL_FLAG(int, health_port, 0,
           "also serve grpc.health.v1 alone in plaintext on this port, for probes that cannot "
           "speak TLS (kubelet gRPC probes); 0: none");
+ABSL_FLAG(int,
+          metrics_port,
+          0,
+          "serve Prometheus metrics (plaintext HTTP, /metrics) on this port of --host; 0: none");
 ABSL_FLAG(absl::Duration,
           grace_period,
           absl::Seconds(10),
@@ -61,6 +65,19 @@ absl::StatusOr<ServerOptions> ServerOptionsFromFlags() {
     options.health_address = host.find(':') != std::string::npos
                                  ? absl::StrCat("[", host, "]:", health_port)
                                  : absl::StrCat(host, ":", health_port);
+  }
+  const int metrics_port = absl::GetFlag(FLAGS_metrics_port);
+  if (metrics_port < 0 || metrics_port > 65535 ||
+      (metrics_port != 0 && (metrics_port == port || metrics_port == health_port))) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--metrics_port must be in [1, 65535] and differ from --port and --health_port (0: none), "
+        "got ",
+        metrics_port));
+  }
+  if (metrics_port != 0) {
+    options.metrics_address = host.find(':') != std::string::npos
+                                  ? absl::StrCat("[", host, "]:", metrics_port)
+                                  : absl::StrCat(host, ":", metrics_port);
   }
   options.grace_period = absl::GetFlag(FLAGS_grace_period);
   options.max_connection_age = absl::GetFlag(FLAGS_max_connection_age);

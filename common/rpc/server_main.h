@@ -1,7 +1,7 @@
 // The part of every service's main that is the same for all: server flags
 // (--host, --port, --max_message_mb, --server_threads, --max_queued_calls,
 // --grace_period, --max_connection_age, --tls_cert, --tls_key, --tls_ca,
-// --health_port), serving until SIGTERM/SIGINT, graceful shutdown.
+// --health_port, --metrics_port), serving until SIGTERM/SIGINT, graceful shutdown.
 //
 //   int main(int argc, char** argv) {
 //     meshseek::rpc::BlockTerminationSignals();
