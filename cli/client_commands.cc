@@ -18,6 +18,7 @@
 #include "cli/commands.h"
 #include "cli/embedded_stack.h"
 #include "cli/pipeline_flags.h"
+#include "cli/session.h"
 #include "common/base/hash.h"
 #include "common/base/progress.h"
 #include "common/base/status_macros.h"
@@ -30,10 +31,6 @@
 #include "common/rpc/status.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"
 
-ABSL_FLAG(std::string, server, "",
-          "coordinator address host:port; empty: start the embedded stack on --data_dir; "
-          "'in-process': eval without services (the benchmark reference)");
-ABSL_FLAG(std::string, data_dir, "meshseek-data", "state folder of the embedded stack");
 ABSL_FLAG(std::string, collection, "",
           "collection name (eval: default <manifest folder>-<method>-<parameter hash>)");
 ABSL_FLAG(std::string, folder, "", "ingest: every mesh file in this folder (id = file name)");
@@ -42,21 +39,18 @@ ABSL_FLAG(int, candidates, 0,
           "query: 0 searches exactly; N re-ranks the N candidates an embedding proposes "
           "(faster on large collections, may miss a neighbour)");
 ABSL_FLAG(std::string, job, "", "status: a job id to follow until it ends");
-ABSL_FLAG(int, port, 50051, "serve: coordinator port of the embedded stack");
-ABSL_FLAG(std::string, tls_ca, "",
-          "PEM CA bundle the coordinator (--server) is verified against: turns TLS on; "
-          "serve: require client certificates signed by it");
-ABSL_FLAG(std::string, tls_cert, "",
-          "PEM certificate this process presents: the client's for mutual TLS, or serve's");
-ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
-ABSL_FLAG(std::string, tls_server_name, "",
-          "name the coordinator's certificate carries, when not the host of --server");
-ABSL_FLAG(std::string, token_file, "",
-          "file holding the coordinator's bearer token: sent with every call to --server; "
-          "serve: required of every caller");
-ABSL_FLAG(absl::Duration, reconnect_for, absl::Minutes(2),
-          "how long the client keeps reconnecting to a coordinator that went away");
-
+ABSL_FLAG(int,
+          metrics_port,
+          0,
+          "serve: Prometheus metrics of all five services on 127.0.0.1:PORT/metrics; 0: none");
+// Defined in session.cc.
+ABSL_DECLARE_FLAG(std::string, server);
+ABSL_DECLARE_FLAG(std::string, data_dir);
+ABSL_DECLARE_FLAG(std::string, tls_ca);
+ABSL_DECLARE_FLAG(std::string, tls_cert);
+ABSL_DECLARE_FLAG(std::string, tls_key);
+ABSL_DECLARE_FLAG(std::string, token_file);
+ABSL_DECLARE_FLAG(absl::Duration, reconnect_for);
 // Defined in eval_command.cc.
 ABSL_DECLARE_FLAG(std::string, manifest);
 ABSL_DECLARE_FLAG(std::string, out);
@@ -69,57 +63,6 @@ namespace {
 // Guards the ingest stream's map of unacknowledged models and the
 // acknowledgement flags the reader thread sets.
 absl::Mutex sent_mutex_;
-
-// A coordinator to talk to: the given --server or an embedded stack.
-class Session {
- public:
-  static absl::StatusOr<std::unique_ptr<Session>> Open() {
-    auto session = std::make_unique<Session>();
-    std::string address = absl::GetFlag(FLAGS_server);
-    if (address.empty()) {
-      MESHSEEK_ASSIGN_OR_RETURN(const MeshReadOptions limits, rpc::MeshLimitsFromFlags());
-      MESHSEEK_ASSIGN_OR_RETURN(session->stack_,
-                                EmbeddedStack::Start(absl::GetFlag(FLAGS_data_dir),
-                                                     absl::GetFlag(FLAGS_threads), 0, {}, limits));
-      address = session->stack_->coordinator_address();
-    }
-    rpc::ChannelOptions channel;
-    channel.retry_service = "";  // the client retries itself, knowing what is idempotent
-    if (session->stack_ == nullptr) {
-      // TLS and token only towards a --server: the command's own stack
-      // listens on loopback in plaintext.
-      rpc::ClientSecurityOptions security;
-      security.tls.ca_file = absl::GetFlag(FLAGS_tls_ca);
-      security.tls.cert_file = absl::GetFlag(FLAGS_tls_cert);
-      security.tls.key_file = absl::GetFlag(FLAGS_tls_key);
-      security.server_name = absl::GetFlag(FLAGS_tls_server_name);
-      security.token_file = absl::GetFlag(FLAGS_token_file);
-      MESHSEEK_ASSIGN_OR_RETURN(channel, rpc::WithClientSecurity(security, channel));
-    }
-    session->stub_ = v1::Coordinator::NewStub(rpc::MakeChannel(address, channel));
-    return session;
-  }
-  v1::Coordinator::Stub* stub() { return stub_.get(); }
-
- private:
-  std::unique_ptr<EmbeddedStack> stack_;
-  std::unique_ptr<v1::Coordinator::Stub> stub_;
-};
-
-rpc::RetryOptions ReconnectRetry() {
-  rpc::RetryOptions retry;
-  retry.attempts = 1 + static_cast<int>(absl::GetFlag(FLAGS_reconnect_for) / absl::Seconds(2));
-  retry.max_backoff = absl::Seconds(2);
-  return retry;
-}
-
-// A unary call with a deadline, retried while the coordinator is unreachable
-// (only for idempotent calls).
-template <typename Request, typename Response, typename Method>
-absl::Status Call(v1::Coordinator::Stub* stub, Method method, const Request& request,
-                  Response* response, absl::Duration deadline = absl::Minutes(1)) {
-  return rpc::CallWithRetry(stub, method, request, response, deadline, ReconnectRetry());
-}
 
 struct ModelToIngest {
   std::string id;
@@ -393,12 +336,18 @@ absl::Status RunServe() {
   security.coordinator.token_file = absl::GetFlag(FLAGS_token_file);
   MESHSEEK_RETURN_IF_ERROR(security.coordinator.Validate());
   MESHSEEK_ASSIGN_OR_RETURN(const MeshReadOptions limits, rpc::MeshLimitsFromFlags());
-  MESHSEEK_ASSIGN_OR_RETURN(auto stack, EmbeddedStack::Start(absl::GetFlag(FLAGS_data_dir),
-                                                             absl::GetFlag(FLAGS_threads),
-                                                             absl::GetFlag(FLAGS_port), security,
-                                                             limits));
+  MESHSEEK_ASSIGN_OR_RETURN(auto stack,
+                            EmbeddedStack::Start(absl::GetFlag(FLAGS_data_dir),
+                                                 absl::GetFlag(FLAGS_threads),
+                                                 PortOr(50051),
+                                                 security,
+                                                 limits,
+                                                 absl::GetFlag(FLAGS_metrics_port)));
   std::printf("meshseek serving on %s (data in %s); Ctrl-C stops\n",
               stack->coordinator_address().c_str(), absl::GetFlag(FLAGS_data_dir).c_str());
+  if (const int metrics = absl::GetFlag(FLAGS_metrics_port); metrics != 0) {
+    std::printf("metrics on http://127.0.0.1:%d/metrics\n", metrics);
+  }
   std::fflush(stdout);
   rpc::WaitForTerminationSignal();
   return absl::OkStatus();

@@ -13,11 +13,14 @@
 namespace meshseek::cli {
 
 absl::Status RunEval();
+// The HTML report of an eval folder (report_command.cc).
+absl::Status RunReport();
 absl::Status RunIngest();
 absl::Status RunBuild();
 absl::Status RunQuery(const std::string& model_path);
 absl::Status RunStatus();
 absl::Status RunServe();
+absl::Status RunWeb();
 
 // eval's two paths: --server=in-process runs the pipeline in this process;
 // otherwise the models go through the coordinator (client_commands.cc).

@@ -11,7 +11,8 @@ absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(
     int threads,
     int coordinator_port,
     const EmbeddedSecurity& security,
-    const MeshReadOptions& mesh_limits) {
+    const MeshReadOptions& mesh_limits,
+    int metrics_port) {
   std::unique_ptr<EmbeddedStack> stack(new EmbeddedStack());
   const int cores = ResolveThreadCount(threads);
   rpc::ServerOptions server;
@@ -48,6 +49,9 @@ absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(
   MESHSEEK_ASSIGN_OR_RETURN(stack->coordinator_, CoordinatorService::Create(coordinator));
   server.address = absl::StrCat("127.0.0.1:", coordinator_port);
   server.security = security.coordinator;
+  // The process has one registry: the endpoint on the coordinator's server
+  // serves the other four's calls as well.
+  if (metrics_port != 0) server.metrics_address = absl::StrCat("127.0.0.1:", metrics_port);
   MESHSEEK_ASSIGN_OR_RETURN(stack->coordinator_address_,
                             serve("coordinator", stack->coordinator_.get()));
   return stack;

@@ -36,13 +36,16 @@ class EmbeddedStack {
   /// Starts the five services; the coordinator listens on `coordinator_port`
   /// (0: any free port) on 127.0.0.1, the others on free loopback ports.
   /// `threads`: extraction slots and coordinator in-flight models (<= 0: cores).
-  /// `mesh_limits` bound the meshes the services accept.
+  /// `mesh_limits` bound the meshes the services accept. `metrics_port`: the
+  /// one Prometheus endpoint of all five services on 127.0.0.1 (their calls
+  /// are labelled by service); 0: none.
   static absl::StatusOr<std::unique_ptr<EmbeddedStack>> Start(
       const std::string& data_dir,
       int threads,
       int coordinator_port = 0,
       const EmbeddedSecurity& security = {},
-      const MeshReadOptions& mesh_limits = {});
+      const MeshReadOptions& mesh_limits = {},
+      int metrics_port = 0);
   ~EmbeddedStack();
 
   /// "127.0.0.1:PORT" of the coordinator.

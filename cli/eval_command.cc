@@ -66,7 +66,10 @@ absl::Status RunEval() {
               t.codebook_seconds,
               t.encode_seconds,
               t.rank_seconds);
-  std::printf("wrote %s/distances.bin and %s/metrics.json\n", out_dir.c_str(), out_dir.c_str());
+  std::printf("wrote %s/distances.bin, %s/models.csv and %s/metrics.json\n",
+              out_dir.c_str(),
+              out_dir.c_str(),
+              out_dir.c_str());
   return absl::OkStatus();
 }
 

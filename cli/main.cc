@@ -1,6 +1,7 @@
 // meshseek: content-based 3-D shape retrieval from the command line.
 //
 //   meshseek eval  --manifest FILE --method dld --out DIR [options]
+//   meshseek report --eval DIR [--out FILE]
 //   meshseek synth --out DIR [--models_per_class N] [--seed S]
 //   meshseek inspect MODEL --method ld|rld|dld --out DIR
 //
@@ -34,9 +35,14 @@ Commands:
          local features, index them, rank all pairs by symmetric KL divergence
          and evaluate:
            meshseek eval --manifest FILE --method dld --out DIR
-         writes DIR/distances.bin (N x N float32, manifest order) and
-         DIR/metrics.json, and prints the metrics table. --server in-process
-         runs the same pipeline without services (the benchmark reference).
+         writes DIR/distances.bin (N x N float32, manifest order),
+         DIR/models.csv and DIR/metrics.json, and prints the metrics table.
+         --server in-process runs the same pipeline without services (the
+         benchmark reference).
+  report Write one self-contained HTML page about an eval run: metrics,
+         first tier per class, precision-recall curves, sample queries' top
+         results as thumbnails:
+           meshseek report --eval DIR [--out DIR/report.html]
   ingest Add models to a collection (created with the method flags if new):
            meshseek ingest --collection C --manifest FILE | --folder DIR
   build  Train the collection's codebook and index every model:
@@ -45,7 +51,10 @@ Commands:
            meshseek query MODEL --collection C --top_k 10
   status Show a collection, or follow a job: meshseek status --collection C | --job ID
   serve  Run the embedded stack until Ctrl-C: meshseek serve --port 50051
-         [--tls_cert C --tls_key K [--tls_ca CA] [--token_file T]]
+         [--tls_cert C --tls_key K [--tls_ca CA] [--token_file T]] [--metrics_port 9464]
+  web    Serve the query page (pick a collection, drop a mesh, see the ranked
+         thumbnails) until Ctrl-C: meshseek web --server HOST:PORT --port 8080
+         (without --server, on an embedded stack on --data_dir)
   synth  Write the built-in labelled synthetic benchmark (procedural shapes):
            meshseek synth --out DIR
          writes DIR/manifest.csv, DIR/synthetic.cla and DIR/models/.
@@ -79,6 +88,8 @@ int main(int argc, char** argv) {
   absl::Status status;
   if (command == "eval") {
     status = meshseek::cli::RunEval();
+  } else if (command == "report") {
+    status = meshseek::cli::RunReport();
   } else if (command == "synth") {
     status = meshseek::cli::RunSynth();
   } else if (command == "inspect") {
@@ -94,10 +105,13 @@ int main(int argc, char** argv) {
     status = meshseek::cli::RunStatus();
   } else if (command == "serve") {
     status = meshseek::cli::RunServe();
+  } else if (command == "web") {
+    status = meshseek::cli::RunWeb();
   } else {
     status = absl::InvalidArgumentError(absl::StrCat(
-        "unknown command '", command,
-        "' (commands: eval, ingest, build, query, status, serve, synth, inspect)"));
+        "unknown command '",
+        command,
+        "' (commands: eval, report, ingest, build, query, status, serve, web, synth, inspect)"));
   }
   return status.ok() ? 0 : Fail(status);
 }

@@ -28,6 +28,7 @@
 #include "common/rpc/convert.h"
 #include "common/rpc/free_port.h"
 #include "common/rpc/status.h"
+#include "common/store/sqlite_db.h"
 #include "common/synth/synthetic_benchmark.h"
 #include "gmock/gmock.h"
 #include "grpc/health/v1/health.grpc.pb.h"
@@ -870,6 +871,98 @@ TEST_F(ServicesTest, AModelThatCannotBeExtractedEndsFailedAndTheBuildGoesOnWitho
   EXPECT_EQ(build.state(), v1::JOB_STATE_SUCCEEDED) << build.DebugString();
   EXPECT_THAT(build.message(), HasSubstr("6 models indexed"));
   EXPECT_THAT(build.message(), HasSubstr("1 failed models left out"));
+}
+
+// What the web page stands on: every model has its thumbnail as soon as it
+// is acknowledged (drawn at ingest, before extraction), the list of
+// collections hides fused collections' members, a model of the collection
+// can be the query, and a removed model's thumbnail goes with it. A model
+// stored before there were thumbnails gets one drawn from its stored mesh.
+TEST_F(ServicesTest, ThumbnailsListingAndQueriesByModelServeTheWebPage) {
+  const std::string dir = *dir_ + "/thumbnails";
+  auto stack = std::make_unique<Stack>(dir, 1);
+  ASSERT_TRUE(stack->WaitServing());
+  auto stub = stack->Coordinator();
+  ASSERT_TRUE(CreateCollection(stub.get(), "pictures").ok());
+  v1::PipelineParams fused;
+  v1::ParamValue* method = fused.add_values();
+  method->set_name("method");
+  method->set_value("lsf+lfd");
+  ASSERT_TRUE(CreateCollection(stub.get(), "both", fused).ok());
+  std::set<std::string> jobs;
+  ASSERT_EQ(Ingest(stub.get(), "pictures", 0, 8, &jobs), 8u);
+
+  auto thumbnail = [&](const std::string& id, v1::Thumbnail* png) {
+    grpc::ClientContext context;
+    rpc::SetDeadline(&context, absl::Seconds(10));
+    v1::GetThumbnailRequest request;
+    request.set_collection("pictures");
+    request.set_model_id(id);
+    return stub->GetThumbnail(&context, request, png);
+  };
+  const std::string& first = (*models_)[0].id;
+  v1::Thumbnail png;
+  ASSERT_TRUE(thumbnail(first, &png).ok());
+  EXPECT_EQ(png.png().substr(1, 3), "PNG");
+  EXPECT_GT(png.png().size(), 1000u);
+  EXPECT_EQ(thumbnail("no-such-model", &png).error_code(), grpc::StatusCode::NOT_FOUND);
+
+  {
+    grpc::ClientContext context;
+    rpc::SetDeadline(&context, absl::Seconds(10));
+    v1::ListCollectionsResponse list;
+    ASSERT_TRUE(stub->ListCollections(&context, v1::ListCollectionsRequest(), &list).ok());
+    std::vector<std::string> names;
+    for (const v1::Collection& c : list.collections()) names.push_back(c.name());
+    EXPECT_THAT(names, ::testing::ElementsAre("both", "pictures"));
+    EXPECT_EQ(list.collections(1).models(), 8u);
+  }
+
+  ASSERT_EQ(WaitJob(stub.get(), *jobs.begin()).state(), v1::JOB_STATE_SUCCEEDED);
+  ASSERT_EQ(WaitJob(stub.get(), Build(stub.get(), "pictures")).state(), v1::JOB_STATE_SUCCEEDED);
+  auto query = [&](v1::QueryRequest request, v1::QueryResponse* response) {
+    grpc::ClientContext context;
+    rpc::SetDeadline(&context, absl::Seconds(30));
+    request.set_collection("pictures");
+    request.set_top_k(3);
+    return stub->Query(&context, request, response);
+  };
+  v1::QueryRequest by_model;
+  by_model.set_model_id((*models_)[3].id);
+  v1::QueryResponse ranked;
+  ASSERT_TRUE(query(by_model, &ranked).ok());
+  ASSERT_EQ(ranked.results_size(), 3);
+  EXPECT_EQ(ranked.results(0).model_id(), (*models_)[3].id);
+  EXPECT_EQ(ranked.results(0).distance(), 0.0f);
+  v1::QueryRequest both = by_model;
+  rpc::MeshToProto(*ReadMesh((*models_)[3].path), both.mutable_mesh()->mutable_mesh());
+  EXPECT_EQ(query(both, &ranked).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  by_model.set_model_id("no-such-model");
+  EXPECT_EQ(query(by_model, &ranked).error_code(), grpc::StatusCode::NOT_FOUND);
+
+  {
+    grpc::ClientContext context;
+    rpc::SetDeadline(&context, absl::Seconds(10));
+    v1::RemoveModelFromCollectionRequest remove;
+    remove.set_collection("pictures");
+    remove.set_model_id(first);
+    v1::RemoveModelFromCollectionResponse removed;
+    ASSERT_TRUE(stub->RemoveModel(&context, remove, &removed).ok());
+  }
+  EXPECT_EQ(thumbnail(first, &png).error_code(), grpc::StatusCode::NOT_FOUND);
+
+  // As an earlier release left it: models without thumbnails.
+  stack.reset();
+  {
+    auto db = Database::Open(dir + "/coordinator/coordinator.db");
+    ASSERT_TRUE(db.ok()) << db.status();
+    ASSERT_TRUE((*db)->Execute("DELETE FROM thumbnails").ok());
+  }
+  stack = std::make_unique<Stack>(dir, 1);
+  ASSERT_TRUE(stack->WaitServing());
+  stub = stack->Coordinator();
+  ASSERT_TRUE(thumbnail((*models_)[1].id, &png).ok());
+  EXPECT_EQ(png.png().substr(1, 3), "PNG");
 }
 
 }  // namespace

@@ -55,10 +55,35 @@ grpc::Status CoordinatorService::Query(grpc::ServerContext*,
     return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
                         absl::StrCat("collection '", request->collection(), "' is not built yet"));
   }
-  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request->mesh(), options_.mesh_limits);
-  if (!mesh.ok()) return rpc::ToGrpcStatus(Prefixed(mesh.status(), "query: "));
   v1::Mesh arrays;
-  rpc::MeshToProto(*mesh, &arrays);
+  if (!request->model_id().empty()) {
+    // A model of the collection: the mesh it was stored with (already
+    // checked at ingest).
+    if (request->has_mesh()) {
+      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                          "query: give a mesh or a model_id, not both");
+    }
+    absl::StatusOr<std::optional<std::string>> stored =
+        store_->ModelMesh({plan->parts.front().name, request->model_id()});
+    if (!stored.ok()) return rpc::ToGrpcStatus(stored.status());
+    if (!stored->has_value()) {
+      return grpc::Status(grpc::StatusCode::NOT_FOUND,
+                          absl::StrCat("query: collection '",
+                                       request->collection(),
+                                       "' has no model '",
+                                       request->model_id(),
+                                       "'"));
+    }
+    if (!arrays.ParseFromString(**stored)) {
+      return grpc::Status(
+          grpc::StatusCode::DATA_LOSS,
+          absl::StrCat("query: model ", request->model_id(), ": stored mesh does not parse"));
+    }
+  } else {
+    absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request->mesh(), options_.mesh_limits);
+    if (!mesh.ok()) return rpc::ToGrpcStatus(Prefixed(mesh.status(), "query: "));
+    rpc::MeshToProto(*mesh, &arrays);
+  }
   // Each part's signature of the query, the parts (methods) side by side.
   const std::size_t parts = plan->parts.size();
   std::vector<absl::StatusOr<IndexSignature>> signatures(parts, absl::UnknownError(""));

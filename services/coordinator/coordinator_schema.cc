@@ -64,6 +64,14 @@ absl::Status RecomputeFingerprints(Database* db) {
   }
 }
 
+// Version 4: a thumbnail per model (PNG), under the collection clients name
+// (a fused collection's, not its members').
+constexpr const char* kSchema4 = R"sql(
+  CREATE TABLE thumbnails (
+    collection TEXT NOT NULL, model_id TEXT NOT NULL, png BLOB NOT NULL,
+    PRIMARY KEY (collection, model_id));
+)sql";
+
 }  // namespace
 
 std::string MeshFingerprint(const std::string& mesh_bytes) {
@@ -85,6 +93,7 @@ absl::Status MigrateCoordinatorSchema(Database* db) {
       MESHSEEK_RETURN_IF_ERROR(RecomputeFingerprints(db));
     }
     if (to == 3) MESHSEEK_RETURN_IF_ERROR(db->Execute(kSchema3));
+    if (to == 4) MESHSEEK_RETURN_IF_ERROR(db->Execute(kSchema4));
     MESHSEEK_RETURN_IF_ERROR(db->SetUserVersion(to));
     MESHSEEK_RETURN_IF_ERROR(transaction.Commit());
     if (version > 0) MESHSEEK_LOG(INFO) << db->path() << ": schema migrated to version " << to;

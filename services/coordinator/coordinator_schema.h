@@ -21,7 +21,7 @@
 namespace meshseek {
 
 /// The schema version this code writes.
-inline constexpr int64_t kCoordinatorSchemaVersion = 3;
+inline constexpr int64_t kCoordinatorSchemaVersion = 4;
 
 /// Brings `db` to kCoordinatorSchemaVersion; FailedPrecondition for a newer
 /// one.

@@ -5,7 +5,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
+#include "common/base/logging.h"
 #include "common/base/status_macros.h"
+#include "common/render/thumbnail.h"
 #include "common/rpc/convert.h"
 #include "common/rpc/status.h"
 
@@ -35,6 +37,28 @@ absl::Status Prefixed(const absl::Status& status, const std::string& prefix) {
   return absl::Status(status.code(), absl::StrCat(prefix, status.message()));
 }
 
+// meshseek_coordinator_models: every stored collection with all three
+// states, zeros included, so that each series exists from the first model.
+absl::StatusOr<std::vector<rpc::GaugeSample>> ModelsByState(CoordinatorStore* store) {
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<CoordinatorStore::StateCount> counts,
+                            store->CountModelsByState());
+  std::map<std::string, std::map<ModelState, uint64_t>> by_collection;
+  for (const CoordinatorStore::StateCount& count : counts) {
+    by_collection[count.collection][count.state] += count.models;
+  }
+  std::vector<rpc::GaugeSample> samples;
+  for (const auto& [collection, states] : by_collection) {
+    for (const auto& [state, name] : {std::pair{ModelState::kPending, "pending"},
+                                      std::pair{ModelState::kExtracted, "extracted"},
+                                      std::pair{ModelState::kFailed, "failed"}}) {
+      const auto it = states.find(state);
+      samples.push_back({{{"collection", collection}, {"state", name}},
+                         it == states.end() ? 0.0 : static_cast<double>(it->second)});
+    }
+  }
+  return samples;
+}
+
 }  // namespace
 
 CoordinatorService::CoordinatorService(const CoordinatorOptions& options,
@@ -55,6 +79,11 @@ absl::StatusOr<std::unique_ptr<CoordinatorService>> CoordinatorService::Create(
   std::unique_ptr<CoordinatorService> service(new CoordinatorService(options, std::move(store)));
   service->dispatcher_.Start();
   MESHSEEK_RETURN_IF_ERROR(service->builds_.ResumeInterrupted());
+  CoordinatorStore* counted = service->store_.get();
+  service->models_gauge_ = rpc::ScrapeGauge::Register(
+      "meshseek_coordinator_models",
+      "Models stored per collection and state (a fused collection's are in its members)",
+      [counted] { return ModelsByState(counted); });
   return service;
 }
 
@@ -159,6 +188,64 @@ grpc::Status CoordinatorService::GetCollection(grpc::ServerContext*,
   return grpc::Status::OK;
 }
 
+grpc::Status CoordinatorService::ListCollections(grpc::ServerContext*,
+                                                 const v1::ListCollectionsRequest*,
+                                                 v1::ListCollectionsResponse* response) {
+  absl::StatusOr<std::vector<std::string>> names = store_->ListCollectionNames();
+  if (!names.ok()) return rpc::ToGrpcStatus(names.status());
+  for (const std::string& name : *names) {
+    absl::StatusOr<v1::Collection> collection = DescribeCollection(name);
+    // Removed meanwhile, or parameters this release cannot read: skip it
+    // here; GetCollection says why.
+    if (!collection.ok()) continue;
+    *response->add_collections() = *std::move(collection);
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status CoordinatorService::GetThumbnail(grpc::ServerContext*,
+                                              const v1::GetThumbnailRequest* request,
+                                              v1::Thumbnail* response) {
+  absl::StatusOr<CollectionPlan> plan = PublicPlan(request->collection());
+  if (!plan.ok()) return rpc::ToGrpcStatus(plan.status());
+  const ModelKey key{request->collection(), request->model_id()};
+  absl::StatusOr<std::optional<std::string>> png = store_->GetThumbnail(key);
+  if (!png.ok()) return rpc::ToGrpcStatus(png.status());
+  if (png->has_value()) {
+    response->set_png(**std::move(png));
+    return grpc::Status::OK;
+  }
+  // Not drawn at ingest (stored by an earlier release, or not drawable):
+  // draw it from the stored mesh now and keep it.
+  absl::StatusOr<std::optional<std::string>> stored =
+      store_->ModelMesh({plan->parts.front().name, request->model_id()});
+  if (!stored.ok()) return rpc::ToGrpcStatus(stored.status());
+  if (!stored->has_value()) {
+    return grpc::Status(
+        grpc::StatusCode::NOT_FOUND,
+        absl::StrCat(
+            "collection '", request->collection(), "' has no model '", request->model_id(), "'"));
+  }
+  v1::MeshInput input;
+  if (!input.mutable_mesh()->ParseFromString(**stored)) {
+    return grpc::Status(
+        grpc::StatusCode::DATA_LOSS,
+        absl::StrCat("model ", request->model_id(), ": stored mesh does not parse"));
+  }
+  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(input, options_.mesh_limits);
+  if (!mesh.ok()) return rpc::ToGrpcStatus(mesh.status());
+  absl::StatusOr<std::string> drawn = RenderThumbnailPng(*mesh);
+  if (!drawn.ok()) {
+    return grpc::Status(
+        grpc::StatusCode::FAILED_PRECONDITION,
+        absl::StrCat(
+            "model ", request->model_id(), ": no thumbnail (", drawn.status().message(), ")"));
+  }
+  if (absl::Status s = store_->SetThumbnail(key, *drawn); !s.ok()) return rpc::ToGrpcStatus(s);
+  response->set_png(*std::move(drawn));
+  return grpc::Status::OK;
+}
+
 grpc::Status CoordinatorService::ListModels(grpc::ServerContext*,
                                             const v1::ListCollectionModelsRequest* request,
                                             v1::ListCollectionModelsResponse* response) {
@@ -213,10 +300,21 @@ absl::StatusOr<v1::IngestAck> CoordinatorService::AcceptModel(const v1::IngestRe
   if (!mesh.ok()) return Prefixed(mesh.status(), absl::StrCat("model ", request.model_id(), ": "));
   v1::Mesh stored;
   rpc::MeshToProto(*mesh, &stored);
-  MESHSEEK_ASSIGN_OR_RETURN(
-      const CoordinatorStore::AddedModel added,
-      store_->AddModel(
-          parts, request.model_id(), request.label(), stored.SerializeAsString(), job_id));
+  // A mesh that cannot be drawn (no extent) is still taken: extraction
+  // decides whether it is usable, and says why not.
+  CoordinatorStore::ModelThumbnail thumbnail{request.collection(), ""};
+  if (absl::StatusOr<std::string> png = RenderThumbnailPng(*mesh); png.ok()) {
+    thumbnail.png = *std::move(png);
+  } else {
+    MESHSEEK_LOG(WARNING) << "model " << request.model_id() << ": no thumbnail: " << png.status();
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(const CoordinatorStore::AddedModel added,
+                            store_->AddModel(parts,
+                                             request.model_id(),
+                                             request.label(),
+                                             stored.SerializeAsString(),
+                                             job_id,
+                                             thumbnail));
   if (added.rows > 0) dispatcher_.ModelAdded(added.rows);
   v1::IngestAck ack;
   ack.set_model_id(request.model_id());
@@ -302,6 +400,10 @@ grpc::Status CoordinatorService::RemoveModel(grpc::ServerContext*,
     if (!state.ok()) return rpc::ToGrpcStatus(state.status());
     if (*state == ModelState::kPending) dispatcher_.PendingModelRemoved();
     removed = removed || state->has_value();
+  }
+  if (absl::Status s = store_->RemoveThumbnail({request->collection(), request->model_id()});
+      !s.ok()) {
+    return rpc::ToGrpcStatus(s);
   }
   response->set_removed(removed);
   return grpc::Status::OK;

@@ -24,6 +24,10 @@
 // builds every member and then the ranking state; queries and evaluation go
 // through the fused collection only.
 //
+// Thumbnails: each model's picture is rendered when it is ingested and
+// stored with it (in the same transaction); a model stored before there
+// were thumbnails gets its picture drawn from its stored mesh on first ask.
+//
 // Ingest: each model of a stream is validated, stored PENDING and only then
 // acknowledged, so an acknowledged model survives kill -9; acknowledgements
 // wait while `max_pending` models wait (backpressure). A model that cannot be
@@ -40,6 +44,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
+#include "common/rpc/metrics.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"
 #include "services/coordinator/build_runner.h"
 #include "services/coordinator/coordinator_options.h"
@@ -85,6 +90,12 @@ class CoordinatorService final : public v1::Coordinator::Service {
   grpc::Status ListModels(grpc::ServerContext* context,
                           const v1::ListCollectionModelsRequest* request,
                           v1::ListCollectionModelsResponse* response) override;
+  grpc::Status ListCollections(grpc::ServerContext* context,
+                               const v1::ListCollectionsRequest* request,
+                               v1::ListCollectionsResponse* response) override;
+  grpc::Status GetThumbnail(grpc::ServerContext* context,
+                            const v1::GetThumbnailRequest* request,
+                            v1::Thumbnail* response) override;
   grpc::Status Evaluate(grpc::ServerContext* context,
                         const v1::EvaluateRequest* request,
                         grpc::ServerWriter<v1::EvaluateRow>* writer) override;
@@ -111,6 +122,8 @@ class CoordinatorService final : public v1::Coordinator::Service {
 
   absl::Mutex rankings_mutex_;
   std::map<std::string, std::shared_ptr<const Ranking>> rankings_ ABSL_GUARDED_BY(rankings_mutex_);
+  // Last: unregistered (waiting for a scrape in progress) before the store goes.
+  std::unique_ptr<rpc::ScrapeGauge> models_gauge_;
 };
 
 }  // namespace meshseek

@@ -4,6 +4,7 @@
 //   models      (mesh, label, ingest ordinal, state, attempts, error,
 //                stored local features, the codebook it was indexed with),
 //   jobs        (ingest and build jobs and their state),
+//   thumbnails  (a PNG per model, under the collection clients name),
 //   rankings    (what the build of a fused or re-ranked collection leaves for
 //                its queries: coordinator/ranking.h),
 //   settings    (facts fixed at first use: the number of index shards).
@@ -154,15 +155,23 @@ class CoordinatorStore {
     std::string job_id;  // the job that first stored it
     int rows = 0;        // PENDING rows stored now (created: at least one)
   };
+  /// A model's picture, kept under `collection`: the one clients name (a
+  /// fused collection's, not its members').
+  struct ModelThumbnail {
+    std::string collection;
+    std::string png;  // empty: none
+  };
   /// Stores a new PENDING model (ordinal: the collection's next) in each of
-  /// `collections` (one, or a fused collection's members) in one
-  /// transaction, or acknowledges the same mesh and label again without
-  /// change; AlreadyExists when the id holds another mesh or label.
+  /// `collections` (one, or a fused collection's members) and its thumbnail
+  /// in one transaction, or acknowledges the same mesh and label again
+  /// without change (storing the thumbnail if there was none);
+  /// AlreadyExists when the id holds another mesh or label.
   absl::StatusOr<AddedModel> AddModel(const std::vector<std::string>& collections,
                                       const std::string& model_id,
                                       const std::string& label,
                                       const std::string& mesh,
-                                      const std::string& job_id);
+                                      const std::string& job_id,
+                                      const ModelThumbnail& thumbnail = {});
   /// Up to `limit` PENDING models whose retry time has come, oldest first,
   /// skipping `busy`.
   absl::StatusOr<std::vector<ModelKey>> ClaimablePending(absl::Time now,
@@ -173,6 +182,14 @@ class CoordinatorStore {
   /// The model if it is still PENDING (not removed or finished meanwhile).
   absl::StatusOr<std::optional<PendingModel>> LoadPending(const ModelKey& key);
   uint64_t PendingCount();
+  /// Rows per (stored collection, state), for the metrics: one aggregate over
+  /// an index. A fused collection's rows are its members'.
+  struct StateCount {
+    std::string collection;
+    ModelState state = ModelState::kPending;
+    uint64_t models = 0;
+  };
+  absl::StatusOr<std::vector<StateCount>> CountModelsByState();
 
   /// A PENDING model's outcome, each in one transaction with its ingest job
   /// finishing when this was the job's last pending model. false when the
@@ -189,6 +206,21 @@ class CoordinatorStore {
   absl::Status MarkIndexed(const ModelKey& key, const std::string& codebook_id);
   /// Deletes the model; its state before, or nullopt when there was none.
   absl::StatusOr<std::optional<ModelState>> RemoveModel(const ModelKey& key);
+
+  /// The mesh (serialized v1::Mesh) a model was ingested with, in any
+  /// state; nullopt when the collection has no such model.
+  absl::StatusOr<std::optional<std::string>> ModelMesh(const ModelKey& key);
+
+  // ------------------------------------------------------------- thumbnails
+  /// nullopt when none is stored (models ingested before thumbnails were,
+  /// or whose mesh could not be drawn).
+  absl::StatusOr<std::optional<std::string>> GetThumbnail(const ModelKey& key);
+  absl::Status SetThumbnail(const ModelKey& key, const std::string& png);
+  absl::Status RemoveThumbnail(const ModelKey& key);
+
+  /// The names of the collections clients created (not fused collections'
+  /// members), sorted.
+  absl::StatusOr<std::vector<std::string>> ListCollectionNames();
 
   /// Every EXTRACTED model of the collection in ingest order.
   absl::StatusOr<std::vector<ExtractedModel>> ExtractedModels(const std::string& collection);

@@ -26,7 +26,8 @@ absl::StatusOr<CoordinatorStore::AddedModel> CoordinatorStore::AddModel(
     const std::string& model_id,
     const std::string& label,
     const std::string& mesh,
-    const std::string& job_id) {
+    const std::string& job_id,
+    const ModelThumbnail& thumbnail) {
   const std::string fingerprint = MeshFingerprint(mesh);
   absl::MutexLock lock(&mutex_);
   MESHSEEK_ASSIGN_OR_RETURN(Transaction transaction, Transaction::Begin(db_.get()));
@@ -64,6 +65,13 @@ absl::StatusOr<CoordinatorStore::AddedModel> CoordinatorStore::AddModel(
                                  .Run());
     const int rows = result.has_value() ? result->rows : 0;
     result = AddedModel{true, job_id, rows + 1};
+  }
+  if (!thumbnail.png.empty()) {
+    MESHSEEK_ASSIGN_OR_RETURN(Statement insert,
+                              db_->Prepare("INSERT OR IGNORE INTO thumbnails (collection, "
+                                           "model_id, png) VALUES (?, ?, ?)"));
+    MESHSEEK_RETURN_IF_ERROR(
+        insert.Bind(1, thumbnail.collection).Bind(2, model_id).BindBlob(3, thumbnail.png).Run());
   }
   MESHSEEK_RETURN_IF_ERROR(transaction.Commit());
   return result.value_or(AddedModel{false, job_id, 0});
@@ -114,6 +122,23 @@ absl::StatusOr<std::optional<PendingModel>> CoordinatorStore::LoadPending(const 
   model.attempts = static_cast<int>(select.ColumnInt(3));
   model.job_id = select.ColumnText(4);
   return model;
+}
+
+absl::StatusOr<std::vector<CoordinatorStore::StateCount>> CoordinatorStore::CountModelsByState() {
+  absl::MutexLock lock(&mutex_);
+  // Walks models_by_state_in_order (collection, state, ...) without a table read.
+  MESHSEEK_ASSIGN_OR_RETURN(
+      Statement select,
+      db_->Prepare("SELECT collection, state, COUNT(*) FROM models GROUP BY collection, state"));
+  std::vector<StateCount> counts;
+  while (true) {
+    MESHSEEK_ASSIGN_OR_RETURN(const bool row, select.Step());
+    if (!row) break;
+    counts.push_back({select.ColumnText(0),
+                      static_cast<ModelState>(select.ColumnInt(1)),
+                      static_cast<uint64_t>(select.ColumnInt(2))});
+  }
+  return counts;
 }
 
 uint64_t CoordinatorStore::PendingCount() {

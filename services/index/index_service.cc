@@ -55,6 +55,18 @@ absl::StatusOr<std::unique_ptr<IndexService>> IndexService::Create(
   }
   std::unique_ptr<IndexService> service(new IndexService(options, std::move(db)));
   MESHSEEK_RETURN_IF_ERROR(service->Load());
+  IndexService* index = service.get();
+  service->models_gauge_ = rpc::ScrapeGauge::Register(
+      "meshseek_index_models",
+      "Models indexed per collection (on this server; a shard holds part of each)",
+      [index]() -> absl::StatusOr<std::vector<rpc::GaugeSample>> {
+        absl::ReaderMutexLock lock(&index->mutex_);
+        std::vector<rpc::GaugeSample> samples;
+        for (const auto& [name, collection] : index->collections_) {
+          samples.push_back({{{"collection", name}}, static_cast<double>(collection.docs.size())});
+        }
+        return samples;
+      });
   return service;
 }
 

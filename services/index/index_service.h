@@ -28,6 +28,7 @@
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
+#include "common/rpc/metrics.h"
 #include "common/search/global_descriptor_index.h"
 #include "common/search/kl_inverted_index.h"
 #include "common/store/sqlite_db.h"
@@ -135,6 +136,9 @@ class IndexService final : public v1::Index::Service {
   // Readers (searches) share it; writers hold it only for the in-memory update.
   absl::Mutex mutex_;
   std::map<std::string, Collection> collections_ ABSL_GUARDED_BY(mutex_);
+  // meshseek_index_models{collection}, read at scrape time. Last: unregistered
+  // (waiting for a scrape in progress) before the collections go.
+  std::unique_ptr<rpc::ScrapeGauge> models_gauge_;
 };
 
 }  // namespace meshseek

@@ -25,6 +25,7 @@ import (
 var (
 	binDir = flag.String("bin", "build/services", "folder of the built meshseek-* binaries")
 	image  = flag.String("image", "meshseek:latest", "the image every container must run")
+	cli    = flag.String("cli", "", "the meshseek command-line binary (default: <bin>/../cli/meshseek)")
 )
 
 type problems []string
@@ -36,7 +37,14 @@ func flagsOf(binary string, cache map[string]string) (string, error) {
 	if help, ok := cache[binary]; ok {
 		return help, nil
 	}
-	out, _ := exec.Command(filepath.Join(*binDir, binary), "--helpfull").CombinedOutput()
+	path := filepath.Join(*binDir, binary)
+	if binary == "meshseek" {
+		path = *cli
+		if path == "" {
+			path = filepath.Join(*binDir, "..", "cli", "meshseek")
+		}
+	}
+	out, _ := exec.Command(path, "--helpfull").CombinedOutput()
 	if !bytes.Contains(out, []byte("Flags from")) {
 		return "", fmt.Errorf("%s: no such binary in %s", binary, *binDir)
 	}
@@ -58,8 +66,19 @@ func checkPod(where string, spec corev1.PodSpec, p *problems, help map[string]st
 			p.add("%s: %v", where, err)
 			continue
 		}
-		port, healthPort, tls := "", "", false
-		for _, a := range c.Args[1:] {
+		// The query page is the CLI's `web` command: an HTTP server, probed
+		// over HTTP on its --port.
+		args := c.Args[1:]
+		web := c.Args[0] == "meshseek" && len(args) > 0 && args[0] == "web"
+		if c.Args[0] == "meshseek" && !web {
+			p.add("%s: container %s runs meshseek %v; only `meshseek web` is a server", where, c.Name, args)
+			continue
+		}
+		if web {
+			args = args[1:]
+		}
+		port, healthPort, metricsPort, tls := "", "", "", false
+		for _, a := range args {
 			name, value, _ := strings.Cut(strings.TrimPrefix(a, "--"), "=")
 			if !strings.Contains(flags, "-"+name+" ") && !strings.Contains(flags, "-"+name+")") {
 				p.add("%s: %s has no flag --%s", where, c.Args[0], name)
@@ -69,6 +88,8 @@ func checkPod(where string, spec corev1.PodSpec, p *problems, help map[string]st
 				port = value
 			case "health_port":
 				healthPort = value
+			case "metrics_port":
+				metricsPort = value
 			case "tls_cert":
 				tls = true
 			}
@@ -76,10 +97,23 @@ func checkPod(where string, spec corev1.PodSpec, p *problems, help map[string]st
 		ports := map[string]int32{}
 		for _, cp := range c.Ports {
 			ports[cp.Name] = cp.ContainerPort
-			if fmt.Sprint(cp.ContainerPort) != port && fmt.Sprint(cp.ContainerPort) != healthPort {
-				p.add("%s: containerPort %d but the server listens on --port=%s (--health_port=%s)",
-					where, cp.ContainerPort, port, healthPort)
+			if listen := fmt.Sprint(cp.ContainerPort); listen != port && listen != healthPort && listen != metricsPort {
+				p.add("%s: containerPort %d but the server listens on --port=%s (--health_port=%s, --metrics_port=%s)",
+					where, cp.ContainerPort, port, healthPort, metricsPort)
 			}
+		}
+		if web {
+			for _, probe := range []*corev1.Probe{c.ReadinessProbe, c.LivenessProbe} {
+				if probe == nil || probe.HTTPGet == nil {
+					p.add("%s: container %s needs HTTP readiness and liveness probes", where, c.Name)
+				} else if probe.HTTPGet.Port.String() != port {
+					p.add("%s: probe on port %s, the page on %s", where, probe.HTTPGet.Port.String(), port)
+				}
+			}
+			if c.Resources.Requests.Cpu().IsZero() || c.Resources.Limits.Memory().IsZero() {
+				p.add("%s: container %s needs resource requests and limits", where, c.Name)
+			}
+			continue
 		}
 		// kubelet's gRPC probes speak plaintext only: a TLS server is probed
 		// on its plaintext health-only port.
@@ -102,6 +136,32 @@ func checkPod(where string, spec corev1.PodSpec, p *problems, help map[string]st
 	}
 	if spec.TerminationGracePeriodSeconds == nil || *spec.TerminationGracePeriodSeconds < 11 {
 		p.add("%s: terminationGracePeriodSeconds must exceed the servers' 10 s drain", where)
+	}
+}
+
+// checkMetrics: a server with --metrics_port is scraped by Prometheus'
+// pod discovery, which finds it by the pod template's annotations.
+func checkMetrics(where string, template corev1.PodTemplateSpec, p *problems) {
+	for _, c := range template.Spec.Containers {
+		for _, a := range c.Args {
+			port, found := strings.CutPrefix(a, "--metrics_port=")
+			if !found {
+				continue
+			}
+			want := map[string]string{"prometheus.io/scrape": "true", "prometheus.io/port": port, "prometheus.io/path": "/metrics"}
+			for key, value := range want {
+				if template.Annotations[key] != value {
+					p.add("%s: container %s serves metrics on %s: pod annotation %s must be %q", where, c.Name, port, key, value)
+				}
+			}
+			named := false
+			for _, cp := range c.Ports {
+				named = named || (cp.Name == "metrics" && fmt.Sprint(cp.ContainerPort) == port)
+			}
+			if !named {
+				p.add("%s: container %s needs containerPort %s named metrics", where, c.Name, port)
+			}
+		}
 	}
 }
 
@@ -147,13 +207,21 @@ func main() {
 			switch o := obj.(type) {
 			case *appsv1.Deployment:
 				checkPod(where, o.Spec.Template.Spec, &p, help)
+				checkMetrics(where, o.Spec.Template, &p)
 			case *appsv1.StatefulSet:
 				checkPod(where, o.Spec.Template.Spec, &p, help)
+				checkMetrics(where, o.Spec.Template, &p)
 				if len(o.Spec.VolumeClaimTemplates) == 0 {
 					p.add("%s: a stateful role needs a volume claim", where)
 				}
 			case *corev1.Service:
 				for _, sp := range o.Spec.Ports {
+					if o.Labels["app.kubernetes.io/component"] == "web" {
+						if sp.TargetPort.String() != "http" || sp.Port != 8080 {
+							p.add("%s: port %d -> %s, want 8080 -> http", where, sp.Port, sp.TargetPort.String())
+						}
+						continue
+					}
 					if sp.TargetPort.String() != "grpc" || sp.Port != 50051 {
 						p.add("%s: port %d -> %s, want 50051 -> grpc", where, sp.Port, sp.TargetPort.String())
 					}
