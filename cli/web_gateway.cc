@@ -14,6 +14,7 @@
 #include "common/base/status_macros.h"
 #include "common/geometry/mesh_io.h"
 #include "common/render/thumbnail.h"
+#include "common/rpc/http_server.h"
 
 namespace meshseek::cli {
 namespace {
@@ -281,16 +282,9 @@ absl::StatusOr<std::unique_ptr<WebGateway>> WebGateway::Start(v1::Coordinator::S
   server.set_exception_handler([](const Request&, Response& r, std::exception_ptr) {
     ReplyError(r, absl::InternalError("internal error in the web gateway"));
   });
-  if (options.port == 0) {
-    gateway->port_ = server.bind_to_any_port(options.host);
-  } else if (server.bind_to_port(options.host, options.port)) {
-    gateway->port_ = options.port;
-  }
-  if (gateway->port_ <= 0) {
-    return absl::UnavailableError(
-        absl::StrCat("web: cannot listen on ", options.host, ":", options.port));
-  }
-  gateway->thread_ = std::thread([&server] { server.listen_after_bind(); });
+  MESHSEEK_ASSIGN_OR_RETURN(gateway->port_,
+                            rpc::BindHttpServer(&server, options.host, options.port, "web"));
+  gateway->thread_ = rpc::ServeHttpInBackground(&server);
   return gateway;
 }
 

@@ -120,6 +120,14 @@ TEST(WebGatewayOptionsTest, DefaultsAreValidAndBoundsAreChecked) {
   EXPECT_EQ(options.Validate().code(), absl::StatusCode::kInvalidArgument);
 }
 
+TEST_F(WebGatewayTest, APortInUseIsUnavailable) {
+  WebGatewayOptions web;
+  web.host = "127.0.0.1";
+  web.port = gateway_->port();
+  auto second = WebGateway::Start(stub_.get(), web);
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kUnavailable) << second.status();
+}
+
 TEST_F(WebGatewayTest, ServesThePageAndItsAssets) {
   auto page = client_->Get("/");
   ASSERT_TRUE(page);

@@ -9,7 +9,10 @@
 #      extract container hard in the middle;
 #   3. checks every model is indexed exactly once and the distance matrix and
 #      metrics equal an embedded run's;
-#   4. brings the stack down and up again and checks the index is still there.
+#   4. checks that every service's metrics endpoint (container:9464) counted
+#      the eval's calls, and that the query page (the web service) lists the
+#      collection, ranks an uploaded model first and serves its thumbnail;
+#   5. brings the stack down and up again and checks the index is still there.
 # Needs a Release build in ./build (scripts/build.sh) for the CLI.
 #   tests/deploy_test.sh [--keep]
 set -euo pipefail
@@ -20,6 +23,7 @@ PROBE=$ROOT/build/services/meshseek-probe
 COMPOSE="docker-compose -p meshseek-test -f deploy/docker-compose.yml"
 export MESHSEEK_IMAGE=meshseek:test
 export MESHSEEK_PORT=${MESHSEEK_PORT:-50551}
+export MESHSEEK_WEB_PORT=${MESHSEEK_WEB_PORT:-50580}
 T=$(mktemp -d)
 cleanup() {
   if [ "${1:-}" != "--keep" ]; then $COMPOSE down -v --remove-orphans >/dev/null 2>&1 || true; fi
@@ -46,10 +50,28 @@ wait_serving() {
   fail "coordinator not serving on port $MESHSEEK_PORT"
 }
 
+# Calls a compose service's containers served so far: the sum of
+# meshseek_rpc_calls_total over each container's own metrics endpoint (not
+# published: read at the container's address on the compose network).
+calls_served() {
+  local total=0 c ip n
+  for c in $($COMPOSE ps -q "$1"); do
+    ip=$(docker inspect -f '{{range .NetworkSettings.Networks}}{{.IPAddress}}{{end}}' "$c")
+    n=$(curl -sf --max-time 5 "http://$ip:9464/metrics" \
+        | awk '/^meshseek_rpc_calls_total/ { s += $2 } END { printf "%d", s }')
+    total=$((total + ${n:-0}))
+  done
+  echo "$total"
+}
+SERVICES="coordinator resample extract codebook index-0 index-1"
+
 step "compose up with 1 extract replica"
 $COMPOSE down -v --remove-orphans >/dev/null 2>&1 || true
 $COMPOSE up -d --scale extract=1 > "$T/compose.log" 2>&1 || { cat "$T/compose.log"; fail "compose up"; }
 wait_serving
+
+declare -A before
+for s in $SERVICES; do before[$s]=$(calls_served "$s"); done
 
 step "eval through the published coordinator; scale extract 1 -> 3 and kill one mid-ingest"
 "$BIN" eval --progress=false --server "localhost:$MESHSEEK_PORT" --collection synthetic \
@@ -78,6 +100,33 @@ status=$("$BIN" status --server "localhost:$MESHSEEK_PORT" --collection syntheti
 echo "$status" | head -1
 echo "$status" | grep -q "72 models, 72 extracted, 72 indexed" || fail "not every model indexed once: $status"
 [ "$($COMPOSE ps -q extract | wc -l)" -eq 3 ] || fail "expected 3 extract containers"
+
+step "metrics: calls each service counted during the eval (its own endpoint, :9464/metrics)"
+for s in $SERVICES; do
+  after=$(calls_served "$s")
+  step "  $s: ${before[$s]} -> $after"
+  # DLD-SIFT, the eval's method, needs no resampling.
+  [ "$s" = resample ] || [ "$after" -gt "${before[$s]}" ] || fail "$s counted no calls"
+done
+ip=$(docker inspect -f '{{range .NetworkSettings.Networks}}{{.IPAddress}}{{end}}' \
+  "$($COMPOSE ps -q coordinator)")
+curl -sf "http://$ip:9464/metrics" | grep '^meshseek_coordinator_models{collection="synthetic"' \
+  | sed 's/^/deploy_test:   /'
+
+step "the query page (web service, port $MESHSEEK_WEB_PORT)"
+web=http://localhost:$MESHSEEK_WEB_PORT
+for _ in $(seq 50); do curl -sf "$web/" >/dev/null && break; sleep 0.2; done
+curl -sf "$web/" | grep -q 'id="results"' || fail "no query page at $web/"
+curl -sf "$web/api/collections" | grep -q '"name":"synthetic"' || fail "web lists no collection"
+query=$(awk -F, 'NR == 2 { print $3 }' "$T/syn/manifest.csv")
+query_id=$(awk -F, 'NR == 2 { print $1 }' "$T/syn/manifest.csv")
+answer=$(curl -sf -F collection=synthetic -F top_k=3 -F "mesh=@$T/syn/$query" "$web/api/query") \
+  || fail "web query failed"
+echo "$answer" | grep -q "\"results\":\[{\"rank\":1,\"model_id\":\"$query_id\"" \
+  || fail "web: $query_id not first: $answer"
+curl -sf "$web/api/thumbnail?collection=synthetic&model_id=$query_id" | head -c 4 | grep -q PNG \
+  || fail "web: no thumbnail"
+step "  uploaded $query: first result $query_id, thumbnail served"
 
 step "down and up again: the index is still there"
 $COMPOSE down > "$T/compose.log" 2>&1 || { cat "$T/compose.log"; fail "compose down"; }

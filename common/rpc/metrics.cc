@@ -1,13 +1,14 @@
 #include "common/rpc/metrics.h"
 
 #include <google/protobuf/descriptor.h>
+#include <httplib.h>
 #include <prometheus/collectable.h>
 #include <prometheus/counter.h>
-#include <prometheus/exposer.h>
 #include <prometheus/family.h>
 #include <prometheus/histogram.h>
 #include <prometheus/metric_family.h>
 #include <prometheus/registry.h>
+#include <prometheus/text_serializer.h>
 
 #include <chrono>
 #include <exception>
@@ -16,10 +17,12 @@
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/status.h"
 #include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
 #include "absl/synchronization/mutex.h"
 #include "common/base/logging.h"
+#include "common/rpc/http_server.h"
 
 namespace meshseek::rpc {
 namespace {
@@ -241,20 +244,35 @@ ScrapeGauge::~ScrapeGauge() { Process()->RemoveGauge(id_); }
 
 absl::StatusOr<std::unique_ptr<MetricsEndpoint>> MetricsEndpoint::Start(
     const std::string& address) {
-  std::unique_ptr<MetricsEndpoint> endpoint(new MetricsEndpoint());
-  try {
-    endpoint->exposer_ = std::make_unique<prometheus::Exposer>(address, 2);
-  } catch (const std::exception& e) {
-    return absl::UnavailableError(
-        absl::StrCat("cannot serve metrics on ", address, " (port in use?): ", e.what()));
+  const std::size_t colon = address.rfind(':');
+  int port = -1;
+  if (colon == std::string::npos || !absl::SimpleAtoi(address.substr(colon + 1), &port) ||
+      port < 0 || port > 65535) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("metrics address must be host:port, got '", address, "'"));
   }
-  endpoint->exposer_->RegisterCollectable(Process());
-  const std::vector<int> ports = endpoint->exposer_->GetListeningPorts();
-  endpoint->port_ = ports.empty() ? 0 : ports.front();
+  std::string host = address.substr(0, colon);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') {
+    host = host.substr(1, host.size() - 2);
+  }
+  if (host.empty()) host = "0.0.0.0";
+  std::unique_ptr<MetricsEndpoint> endpoint(new MetricsEndpoint());
+  endpoint->server_ = std::make_unique<httplib::Server>();
+  endpoint->server_->Get("/metrics", [](const httplib::Request&, httplib::Response& response) {
+    response.set_content(prometheus::TextSerializer().Serialize(Process()->Collect()),
+                         "text/plain; version=0.0.4; charset=utf-8");
+  });
+  absl::StatusOr<int> bound = BindHttpServer(endpoint->server_.get(), host, port, "metrics");
+  if (!bound.ok()) return bound.status();
+  endpoint->port_ = *bound;
+  endpoint->thread_ = ServeHttpInBackground(endpoint->server_.get());
   return endpoint;
 }
 
-MetricsEndpoint::~MetricsEndpoint() = default;
+MetricsEndpoint::~MetricsEndpoint() {
+  server_->stop();
+  if (thread_.joinable()) thread_.join();
+}
 
 std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface> MetricsInterceptorFactory(
     const std::string& service) {

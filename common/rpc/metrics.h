@@ -22,12 +22,13 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "absl/status/statusor.h"
 
-namespace prometheus {
-class Exposer;
+namespace httplib {
+class Server;
 }
 
 namespace meshseek::rpc {
@@ -62,7 +63,9 @@ class ScrapeGauge {
 };
 
 /// Serves the process's metrics at http://ADDRESS/metrics (Prometheus text
-/// format) until destroyed.
+/// format) until destroyed. cpp-httplib, as the web gateway: its threads have
+/// the default stack (civetweb's, behind prometheus-cpp's own exposer, are
+/// too small for a scrape under AddressSanitizer).
 class MetricsEndpoint {
  public:
   /// `address`: host:port; port 0 picks a free one. Unavailable when it
@@ -74,7 +77,8 @@ class MetricsEndpoint {
 
  private:
   MetricsEndpoint() = default;
-  std::unique_ptr<prometheus::Exposer> exposer_;
+  std::unique_ptr<httplib::Server> server_;
+  std::thread thread_;
   int port_ = 0;
 };
 
