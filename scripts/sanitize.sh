@@ -96,7 +96,8 @@ for step in $STEPS; do
       configure build-tsan g++ "-fsanitize=thread -fno-omit-frame-pointer" \
         "-fsanitize=thread -Wl,--no-as-needed $shim -Wl,--as-needed"
       cmake --build build-tsan --target tests_services_test tests_end_to_end_test \
-        tests_hostile_input_test tests_security_test meshseek-probe \
+        tests_hostile_input_test tests_security_test tests_report_test tests_metrics_test \
+        meshseek meshseek-probe \
         -- -j"$JOBS"
       reports=$PWD/build-tsan/sanitizer-reports
       rm -rf "$reports" && mkdir -p "$reports/tmp"
