@@ -51,7 +51,7 @@ absl::StatusOr<CodebookService::Entry> CodebookService::Find(const std::string& 
   return entry;
 }
 
-grpc::Status CodebookService::Train(grpc::ServerContext*,
+grpc::Status CodebookService::Train(grpc::ServerContext* context,
                                     grpc::ServerReader<v1::TrainCodebookRequest>* reader,
                                     v1::CodebookInfo* response) {
   v1::TrainCodebookRequest first;
@@ -89,6 +89,13 @@ grpc::Status CodebookService::Train(grpc::ServerContext*,
                                        chunk.dimension(), ", the first had ", dim));
     }
     descriptors += chunk.descriptors();
+  }
+  // A stream also ends when its client dies (a coordinator killed mid-build):
+  // that is a cut-off sample, and a codebook trained on it and stored under
+  // the build's id would be what the resumed build finds and uses.
+  if (context->IsCancelled()) {
+    return grpc::Status(grpc::StatusCode::CANCELLED,
+                        absl::StrCat("train ", id, ": the stream was cut off; nothing trained"));
   }
   if (descriptors.size() % dim != 0) {
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
