@@ -217,7 +217,15 @@ absl::Status IngestModels(v1::Coordinator::Stub* stub, const std::string& collec
   return absl::OkStatus();
 }
 
+// A collection that exists keeps its parameters (the parameter flags only
+// say how to create one); flags that disagree with them are an error.
 absl::Status EnsureCollection(v1::Coordinator::Stub* stub, const std::string& name) {
+  v1::GetCollectionRequest get;
+  get.set_name(name);
+  v1::Collection existing;
+  const absl::Status found = Call(stub, &v1::Coordinator::Stub::GetCollection, get, &existing);
+  if (found.ok()) return CheckFlagsAgreeWith(existing.params(), name);
+  if (!absl::IsNotFound(found)) return found;
   v1::CreateCollectionRequest create;
   create.set_name(name);
   MESHSEEK_ASSIGN_OR_RETURN(*create.mutable_params(), CollectionParamsFromFlags());
@@ -298,14 +306,15 @@ absl::Status RunStatus() {
   }
   if (params.empty()) params = info.params().ShortDebugString();  // a legacy collection
   std::printf(
-      "collection %s: %llu models, %llu pending, %llu extracted, %llu failed, %llu indexed; "
-      "index generation '%s'\nparams: %s\n",
+      "collection %s: %llu models, %llu pending, %llu extracted, %llu failed, %llu indexed "
+      "(%llu added since the build); index generation '%s'\nparams: %s\n",
       info.name().c_str(),
       static_cast<unsigned long long>(info.models()),
       static_cast<unsigned long long>(info.pending()),
       static_cast<unsigned long long>(info.extracted()),
       static_cast<unsigned long long>(info.failed()),
       static_cast<unsigned long long>(info.indexed()),
+      static_cast<unsigned long long>(info.added_since_build()),
       info.codebook_id().c_str(),
       params.c_str());
   // Every failed model and why, a page at a time.
@@ -395,7 +404,10 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
   v1::Collection info;
   MESHSEEK_RETURN_IF_ERROR(Call(stub, &v1::Coordinator::Stub::GetCollection, get, &info));
   const auto build_start = absl::Now();
-  if (info.codebook_id().empty() || info.indexed() != info.models()) {
+  // The paper's protocol: codebooks trained on every model evaluated, so
+  // models added live since the last build mean a build too.
+  if (info.codebook_id().empty() || info.indexed() != info.models() ||
+      info.added_since_build() > 0) {
     MESHSEEK_RETURN_IF_ERROR(BuildCollection(stub, collection));
   }
   evaluation.timings.codebook_seconds = absl::ToDoubleSeconds(absl::Now() - build_start);

@@ -1,12 +1,16 @@
 #include "cli/pipeline_flags.h"
 
+#include <algorithm>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "common/base/status_macros.h"
 #include "common/pipeline/pipeline_params.h"
 #include "common/rpc/convert.h"
@@ -95,6 +99,51 @@ absl::StatusOr<v1::PipelineParams> CollectionParamsFromFlags() {
   v1::PipelineParams params;
   rpc::CollectionParamsToProto(options, &params);
   return params;
+}
+
+absl::Status CheckFlagsAgreeWith(const v1::PipelineParams& params, absl::string_view collection) {
+  if (GivenValues().empty()) return absl::OkStatus();
+  if (!MissingValue().empty()) {
+    return absl::InvalidArgumentError(absl::StrCat("--", MissingValue(), " needs a value"));
+  }
+  const auto value_in = [](const v1::PipelineParams& p,
+                           const std::string& name) -> std::optional<std::string> {
+    for (const v1::ParamValue& v : p.values()) {
+      if (v.name() == name) return v.value();
+    }
+    return std::nullopt;
+  };
+  const auto conflict = [&](absl::string_view what) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "collection '", collection, "' exists with other parameters: ", what,
+        ". Its own parameters apply to what is added: leave the flags out, or use another "
+        "collection"));
+  };
+  // The flags read as they would be for this collection's methods (unless
+  // they name others), both sides canonical: "--scale 0.10" agrees with 0.1.
+  ParamValues values = GivenValues();
+  const bool method_given = std::any_of(values.begin(), values.end(),
+                                        [](const auto& v) { return v.first == "method"; });
+  if (!method_given && value_in(params, "method").has_value()) {
+    values.insert(values.begin(), {"method", *value_in(params, "method")});
+  }
+  absl::StatusOr<CollectionOptions> options = CollectionOptionsFromValues(values);
+  if (!options.ok()) return conflict(options.status().message());
+  v1::PipelineParams given;
+  rpc::CollectionParamsToProto(*options, &given);
+  std::vector<std::string> problems;
+  for (const auto& [name, unused] : GivenValues()) {
+    const std::optional<std::string> stored = value_in(params, name);
+    const std::optional<std::string> asked = value_in(given, name);
+    if (!stored.has_value()) {
+      problems.push_back(absl::StrCat("--", name, " does not apply to it"));
+    } else if (asked != stored) {
+      problems.push_back(absl::StrCat("--", name, " ", asked.value_or("?"), " (it has ", name, "=",
+                                      *stored, ")"));
+    }
+  }
+  if (problems.empty()) return absl::OkStatus();
+  return conflict(absl::StrJoin(problems, "; "));
 }
 
 }  // namespace meshseek::cli

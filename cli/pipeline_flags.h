@@ -29,6 +29,12 @@ std::vector<char*> ParseCommandLineWithParams(int argc, char** argv, absl::strin
 // CollectionOptionsFromFlags.
 absl::StatusOr<v1::PipelineParams> CollectionParamsFromFlags();
 
+// For a command on an existing collection (ingest): OK when every parameter
+// flag given agrees with the collection's stored `params` (none given: the
+// collection's own parameters apply); otherwise InvalidArgument naming each
+// flag that conflicts (and the collection's value) or does not apply to it.
+absl::Status CheckFlagsAgreeWith(const v1::PipelineParams& params, absl::string_view collection);
+
 // Options from the parameter flags (--method, --scale, --points, --vocabulary,
 // --rld.vocabulary, --weights, --rerank, ...) and --threads / --progress,
 // validated: InvalidArgument names the bad parameter and value.

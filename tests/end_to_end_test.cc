@@ -182,6 +182,56 @@ TEST_F(EndToEndTest, CliNamesTheModelAndLineOfABadMeshAndFailsCleanly) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/out/distances.bin"));
 }
 
+// Ingest into an existing collection takes its parameters: method flags only
+// say how to create one, a conflicting or inapplicable flag is an error
+// naming it, and a model added after the build is searchable (status counts
+// it) with no build.
+TEST_F(EndToEndTest, CliIngestIntoAnExistingCollectionKeepsItsParameters) {
+  const std::string dir = *dir_ + "/grow";
+  std::filesystem::create_directories(dir);
+  std::ifstream all(*dir_ + "/bench/manifest.csv");
+  std::string line;
+  std::getline(all, line);
+  std::ofstream first(dir + "/first.csv"), later(dir + "/later.csv");
+  first << line << "\n";
+  later << line << "\n";
+  for (int i = 0; i < 9 && std::getline(all, line); ++i) {
+    // Paths relative to the benchmark's folder.
+    const std::size_t comma = line.rfind(',');
+    const std::string row = line.substr(0, comma + 1) + *dir_ + "/bench/" + line.substr(comma + 1);
+    (i < 8 ? first : later) << row << "\n";
+  }
+  first.close();
+  later.close();
+  const auto command = [&](const std::string& verb) {
+    return std::string(MESHSEEK_CLI_PATH) + " " + verb + " --progress=false --data_dir " + dir +
+           "/data --collection grow ";
+  };
+  std::string output;
+  ASSERT_EQ(RunCommand(command("ingest") + "--manifest " + dir + "/first.csv --method lsf "
+                                           "--vocabulary 16",
+                       &output),
+            0)
+      << output;
+  ASSERT_EQ(RunCommand(command("build"), &output), 0) << output;
+  // Exit code 2: a usage error, as for any bad flag.
+  EXPECT_EQ(RunCommand(command("ingest") + "--manifest " + dir + "/later.csv --method dld", &output),
+            2);
+  EXPECT_THAT(output, HasSubstr("--method dld (it has method=lsf)"));
+  EXPECT_EQ(
+      RunCommand(command("ingest") + "--manifest " + dir + "/later.csv --rld.vocabulary 9", &output),
+      2);
+  EXPECT_THAT(output, HasSubstr("collection 'grow' exists with other parameters"));
+  EXPECT_THAT(output, HasSubstr("rld.vocabulary"));
+  // Without flags, or with flags that agree, its own parameters apply.
+  ASSERT_EQ(RunCommand(command("ingest") + "--manifest " + dir + "/later.csv --vocabulary 16",
+                       &output),
+            0)
+      << output;
+  ASSERT_EQ(RunCommand(command("status"), &output), 0) << output;
+  EXPECT_THAT(output, HasSubstr("9 indexed (1 added since the build)"));
+}
+
 TEST_F(EndToEndTest, CliRejectsBadFlagsWithAClearMessage) {
   std::string output;
   EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --out /tmp/x", &output), 2);

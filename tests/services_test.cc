@@ -649,7 +649,8 @@ TEST_F(ServicesTest, AGlobalDescriptorCollectionSurvivesKillsAndEqualsInProcess)
 // A fused, re-ranked collection (LSF + LFD, small settings): each model
 // stored in both members, each extracted with its method, the build builds
 // both and the ranking state; over two shards, with the coordinator killed
-// during the build, Evaluate gives the in-process matrix bit for bit.
+// during the build, Evaluate gives the in-process matrix bit for bit. A
+// model ingested afterwards is searchable with no build (live ingest).
 TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
   v1::PipelineParams params;
   for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
@@ -722,6 +723,62 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
   stack.coordinator().Start();
   ASSERT_TRUE(stack.WaitServing());
   EXPECT_EQ(Evaluate(stub.get(), "fused", n), reference->distances);
+
+  // Live ingest: a model ingested into the built collection, the
+  // coordinator killed right after acknowledging it, is its own first result
+  // within 2 s of its extraction ending, with no build.
+  {
+    std::set<std::string> live_jobs;
+    ASSERT_EQ(Ingest(stub.get(), "fused", n, n + 1, &live_jobs), 1u);
+    stack.coordinator().Kill(SIGKILL);
+    stack.coordinator().Start();
+    ASSERT_TRUE(stack.WaitServing());
+    ASSERT_EQ(live_jobs.size(), 1u);
+    ASSERT_EQ(WaitJob(stub.get(), *live_jobs.begin()).state(), v1::JOB_STATE_SUCCEEDED);
+    const absl::Time extracted = absl::Now();
+    v1::QueryResponse found;
+    while (absl::Now() - extracted < absl::Seconds(2 * kSlowdown)) {
+      found.Clear();
+      if (Query(stub.get(), "fused", n, 3, absl::Seconds(10), &found).ok() &&
+          found.results_size() > 0 && found.results(0).model_id() == (*models_)[n].id) {
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_GT(found.results_size(), 0);
+    EXPECT_EQ(found.results(0).model_id(), (*models_)[n].id)
+        << "not searchable " << absl::FormatDuration(absl::Now() - extracted)
+        << " after its extraction ended";
+    grpc::ClientContext context;
+    v1::GetCollectionRequest get;
+    get.set_name("fused");
+    v1::Collection info;
+    ASSERT_TRUE(stub->GetCollection(&context, get, &info).ok());
+    EXPECT_EQ(info.indexed(), n + 1);
+    EXPECT_EQ(info.added_since_build(), 1u);
+    // Restarted again, the join is replayed from the store.
+    stack.coordinator().Kill(SIGKILL);
+    stack.coordinator().Start();
+    ASSERT_TRUE(stack.WaitServing());
+    found.Clear();
+    ASSERT_TRUE(Query(stub.get(), "fused", n, 3, absl::Seconds(60), &found).ok());
+    ASSERT_GT(found.results_size(), 0);
+    EXPECT_EQ(found.results(0).model_id(), (*models_)[n].id);
+  }
+  // Candidates cannot act on a fused collection: an error, never ignored.
+  {
+    grpc::ClientContext context;
+    rpc::SetDeadline(&context, absl::Seconds(60));
+    v1::QueryRequest request;
+    request.set_collection("fused");
+    request.set_top_k(3);
+    request.set_candidates(10);
+    request.set_model_id((*models_)[0].id);
+    v1::QueryResponse ignored;
+    const grpc::Status refused = stub->Query(&context, request, &ignored);
+    EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(refused.error_message(), HasSubstr("candidates=10 does not apply"));
+  }
 
   // A model queried joins the graph beside its stored copy: that copy first.
   v1::QueryResponse response;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "absl/strings/str_cat.h"
 #include "common/base/byte_order.h"
@@ -74,6 +75,82 @@ void NeighborGraph::SetRow(uint32_t i, absl::Span<const float> row) {
   };
   std::partial_sort(all.begin(), all.begin() + k_, all.end(), before);
   std::copy(all.begin(), all.begin() + k_, lists_.begin() + static_cast<std::size_t>(i) * k_);
+}
+
+GraphJoin NeighborGraph::PlanJoin(absl::Span<const float> row, int k) const {
+  const uint32_t self = static_cast<uint32_t>(n_);
+  // Lists keep their length k_, or grow by one while they hold every node.
+  const bool grow = k_ > 0 && static_cast<std::size_t>(k_) == n_ && k > k_;
+  const std::size_t take = k_ > 0 ? static_cast<std::size_t>(grow ? k_ : k_ - 1) : 0;
+  GraphJoin join;
+  std::vector<GraphNeighbor> all(n_);
+  for (uint32_t j = 0; j < n_; ++j) all[j] = GraphNeighbor{j, row[j]};
+  std::partial_sort(all.begin(), all.begin() + take, all.end(),
+                    [self](const GraphNeighbor& a, const GraphNeighbor& b) {
+                      return NeighborBefore(self, a, b);
+                    });
+  join.list.push_back(GraphNeighbor{self, 0.0f});
+  join.list.insert(join.list.end(), all.begin(), all.begin() + take);
+  for (uint32_t y = 0; y < n_; ++y) {
+    if (grow || row[y] < Of(y).back().distance) join.entered.push_back(GraphNeighbor{y, row[y]});
+  }
+  return join;
+}
+
+absl::Status NeighborGraph::ApplyJoin(const GraphJoin& join) {
+  const uint32_t self = static_cast<uint32_t>(n_);
+  if (k_ < 1) return absl::InvalidArgumentError("neighbour graph: joined before Create");
+  if (n_ + 1 > kMaxNodes) return absl::InvalidArgumentError("neighbour graph: full");
+  const bool grow = static_cast<std::size_t>(k_) == n_ && join.list.size() == n_ + 1 &&
+                    k_ < kMaxK;
+  const std::size_t length = static_cast<std::size_t>(k_) + (grow ? 1 : 0);
+  if (join.list.size() != length || join.list.front().node != self) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "neighbour graph: a join list of ", join.list.size(), " for lists of ", k_));
+  }
+  for (std::size_t j = 1; j < join.list.size(); ++j) {
+    const GraphNeighbor& e = join.list[j];
+    if (e.node >= n_ || std::isnan(e.distance) || e.distance < 0 ||
+        !NeighborBefore(self, join.list[j - 1], e)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("neighbour graph: join list entry ", j, " is not a node in order"));
+    }
+  }
+  for (const GraphNeighbor& e : join.entered) {
+    if (e.node >= n_ || std::isnan(e.distance) || e.distance < 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("neighbour graph: join enters list ", e.node, " of ", n_));
+    }
+  }
+  if (grow && join.entered.size() != n_) {
+    return absl::InvalidArgumentError("neighbour graph: a growing join must enter every list");
+  }
+  if (grow) {
+    // Every list one longer: re-laid out with a free last slot.
+    std::vector<GraphNeighbor> wider(n_ * length);
+    for (std::size_t i = 0; i < n_; ++i) {
+      std::copy(lists_.begin() + i * k_, lists_.begin() + (i + 1) * k_, wider.begin() + i * length);
+      wider[i * length + k_] = GraphNeighbor{self, std::numeric_limits<float>::infinity()};
+    }
+    lists_.swap(wider);
+    k_ = static_cast<int>(length);
+  }
+  for (const GraphNeighbor& e : join.entered) {
+    GraphNeighbor* list = lists_.data() + static_cast<std::size_t>(e.node) * k_;
+    const GraphNeighbor entry{self, e.distance};
+    // A grown list's free slot is the new node's own: search before it.
+    GraphNeighbor* end = list + k_ - (grow ? 1 : 0);
+    GraphNeighbor* at = std::upper_bound(
+        list + 1, end, entry, [&e](const GraphNeighbor& a, const GraphNeighbor& b) {
+          return NeighborBefore(e.node, a, b);
+        });
+    if (!grow && at == end) continue;  // not nearer than the last after all
+    std::copy_backward(at, list + k_ - 1, list + k_);
+    *at = entry;
+  }
+  lists_.insert(lists_.end(), join.list.begin(), join.list.end());
+  ++n_;
+  return absl::OkStatus();
 }
 
 std::string NeighborGraph::Serialize() const {

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "absl/types/span.h"
@@ -32,6 +33,15 @@ struct GraphNeighbor {
   uint32_t node = 0;
   float distance = 0.0f;
   bool operator==(const GraphNeighbor& o) const { return node == o.node && distance == o.distance; }
+};
+
+/// What a new node changes in a graph (NeighborGraph::PlanJoin): its own
+/// list, and the lists it enters, each as (node whose list it enters, the
+/// distance between them). Small: k entries, and on average about k entered
+/// lists, so a live collection can store it per model and replay it.
+struct GraphJoin {
+  std::vector<GraphNeighbor> list;
+  std::vector<GraphNeighbor> entered;
 };
 
 /// Orders neighbours of `self`'s list: itself first, then by (distance, node).
@@ -61,6 +71,20 @@ class NeighborGraph {
   /// the entry for i itself is ignored). Rows may be set from several
   /// threads at once, each row by one.
   void SetRow(uint32_t i, absl::Span<const float> row);
+
+  /// Live growth (docs/design.md, "Live ingest"). The join of a new node
+  /// n = size() from its distances to nodes 0 .. n - 1 (`row`, n values, none
+  /// NaN), in a graph whose lists were asked to hold `k` (as at Create): its
+  /// list as SetRow would set it, and every list whose last entry it is
+  /// nearer than (strictly: the older node keeps a tie, as NeighborBefore
+  /// orders them). A graph that holds every node in every list (fewer nodes
+  /// than k) grows its lists by one instead, the new node entering each.
+  /// Applied, the graph is the one FromMatrix(.., n + 1, k) would build.
+  GraphJoin PlanJoin(absl::Span<const float> row, int k) const;
+  /// Appends node size() as `join` says. InvalidArgument (and nothing
+  /// changed) for a join of another graph: a list of another length, out of
+  /// order, or naming a node that does not exist.
+  absl::Status ApplyJoin(const GraphJoin& join);
 
   std::size_t size() const { return n_; }
   /// List length: min(k, n) (k for an empty graph).

@@ -76,6 +76,69 @@ TEST(NeighborGraphTest, SerializedGraphReadsBackAndDamageIsNamed) {
             std::string::npos);
 }
 
+// Nodes joined one by one give the graph built over all of them at once,
+// ties (a repeated point) and +inf included.
+TEST(NeighborGraphTest, JoinedNodesGiveTheGraphOfTheWholeMatrix) {
+  std::mt19937 rng(11);
+  std::vector<float> x(60);
+  for (float& v : x) v = static_cast<float>(rng() % 200) / 4.0f;
+  x[50] = x[3];  // a tie, joined late
+  std::vector<float> d = LineMatrix(x);
+  const std::size_t n = x.size();
+  const float inf = std::numeric_limits<float>::infinity();
+  for (std::size_t j = 0; j < n; ++j) {  // model 55 has no features
+    if (j != 55) d[55 * n + j] = d[j * n + 55] = inf;
+  }
+  const std::size_t built = 20;
+  {
+    // From fewer nodes than k: the lists grow until they reach it.
+    auto small = NeighborGraph::FromMatrix({0}, 1, 7, 1);
+    ASSERT_TRUE(small.ok());
+    for (std::size_t i = 1; i < n; ++i) {
+      std::vector<float> row(d.begin() + i * n, d.begin() + i * n + i);
+      ASSERT_TRUE(small->ApplyJoin(small->PlanJoin(row, 7)).ok()) << i;
+    }
+    EXPECT_EQ(small->k(), 7);
+    EXPECT_TRUE(*small == *NeighborGraph::FromMatrix(d, n, 7, 1));
+  }
+  std::vector<float> first;
+  for (std::size_t i = 0; i < built; ++i) {
+    first.insert(first.end(), d.begin() + i * n, d.begin() + i * n + built);
+  }
+  auto graph = NeighborGraph::FromMatrix(first, built, 7, 1);
+  ASSERT_TRUE(graph.ok());
+  for (std::size_t i = built; i < n; ++i) {
+    const GraphJoin join = graph->PlanJoin(absl::MakeConstSpan(d.data() + i * n, i), 7);
+    ASSERT_TRUE(graph->ApplyJoin(join).ok());
+  }
+  auto whole = NeighborGraph::FromMatrix(d, n, 7, 1);
+  ASSERT_TRUE(whole.ok());
+  EXPECT_TRUE(*graph == *whole);
+  // Replayed from the serialised graph it round-trips too.
+  auto back = NeighborGraph::Parse(graph->Serialize());
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_TRUE(*back == *whole);
+}
+
+TEST(NeighborGraphTest, AJoinOfAnotherGraphIsRefusedAndChangesNothing) {
+  const std::vector<float> x = {0, 1, 2, 3, 4};
+  auto graph = NeighborGraph::FromMatrix(LineMatrix(x), x.size(), 3, 1);
+  ASSERT_TRUE(graph.ok());
+  const NeighborGraph before = *graph;
+  GraphJoin join = graph->PlanJoin(std::vector<float>{5, 4, 3, 2, 1}, 3);
+  GraphJoin short_list = join;
+  short_list.list.pop_back();
+  EXPECT_EQ(graph->ApplyJoin(short_list).code(), absl::StatusCode::kInvalidArgument);
+  GraphJoin bad_node = join;
+  bad_node.entered.push_back(GraphNeighbor{9, 1.0f});
+  EXPECT_EQ(graph->ApplyJoin(bad_node).code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_TRUE(*graph == before);
+  EXPECT_TRUE(graph->ApplyJoin(join).ok());
+  EXPECT_EQ(graph->size(), 6u);
+  EXPECT_EQ(graph->Of(4)[2], (GraphNeighbor{5, 1.0f}));  // after 3, at the same distance
+  EXPECT_FALSE(NeighborGraph().ApplyJoin(join).ok());
+}
+
 TEST(NeighborGraphTest, BadInputIsRefused) {
   EXPECT_FALSE(NeighborGraph::Create(10, 0).ok());
   EXPECT_FALSE(NeighborGraph::Create(10, NeighborGraph::kMaxK + 1).ok());

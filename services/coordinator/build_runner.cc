@@ -23,9 +23,10 @@ absl::Status Prefixed(const absl::Status& status, const std::string& prefix) {
 
 BuildRunner::BuildRunner(CoordinatorStore* store,
                          Workers* workers,
+                         LiveIndex* live,
                          const CoordinatorOptions& options,
                          const std::atomic<bool>* stop)
-    : store_(store), workers_(workers), options_(options), stop_(stop) {}
+    : store_(store), workers_(workers), live_(live), options_(options), stop_(stop) {}
 
 BuildRunner::~BuildRunner() { Join(); }
 
@@ -84,12 +85,27 @@ absl::StatusOr<std::string> BuildRunner::Start(const std::string& collection) {
 
 absl::Status BuildRunner::ResumeInterrupted() {
   MESHSEEK_ASSIGN_OR_RETURN(const auto builds, store_->RunningBuilds());
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<std::string> names, store_->ListCollectionNames());
   absl::MutexLock lock(&mutex_);
   for (const auto& [job, collection] : builds) {
     if (!building_.insert(collection).second) continue;
     MESHSEEK_LOG(INFO) << "coordinator: resuming " << job << " of collection " << collection;
     threads_.emplace_back([this, job = job, collection = collection] { Run(job, collection); });
   }
+  // The others: what a kill cut off between extraction and ranking. A
+  // resumed build catches up when it ends.
+  std::vector<std::string> idle;
+  for (const std::string& name : names) {
+    if (building_.count(name) == 0) idle.push_back(name);
+  }
+  threads_.emplace_back([this, idle = std::move(idle)] {
+    for (const std::string& name : idle) {
+      if (*stop_) return;
+      if (absl::Status s = live_->CatchUp(name); !s.ok() && !*stop_) {
+        MESHSEEK_LOG(WARNING) << "coordinator: " << name << ": live indexing: " << s;
+      }
+    }
+  });
   return absl::OkStatus();
 }
 
@@ -266,6 +282,10 @@ void BuildRunner::Run(const std::string& job_id, const std::string& collection) 
   }
   (void)store_->FinishJob(job_id, v1::JOB_STATE_SUCCEEDED, message);
   Done(collection);
+  // Models extracted while the build ran: indexed with the new codebooks now.
+  if (absl::Status s = live_->CatchUp(collection); !s.ok() && !*stop_) {
+    MESHSEEK_LOG(WARNING) << "coordinator: " << collection << ": live indexing: " << s;
+  }
 }
 
 }  // namespace meshseek

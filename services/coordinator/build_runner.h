@@ -6,7 +6,10 @@
 // ("<collection>@<job>") and each model records the codebook it was indexed
 // with, so a build interrupted by a restart resumes where it was
 // (ResumeInterrupted). Failed models are left out, and the job's message
-// says how many. One build per collection at a time.
+// says how many. One build per collection at a time. A build is never what
+// makes a model searchable (live_index.h): after one, live indexing catches
+// up with the models extracted while it ran; after a restart, with what the
+// restart cut off.
 #ifndef MESHSEEK_SERVICES_COORDINATOR_BUILD_RUNNER_H_
 #define MESHSEEK_SERVICES_COORDINATOR_BUILD_RUNNER_H_
 
@@ -21,6 +24,7 @@
 #include "absl/synchronization/mutex.h"
 #include "services/coordinator/coordinator_options.h"
 #include "services/coordinator/coordinator_store.h"
+#include "services/coordinator/live_index.h"
 #include "services/coordinator/workers.h"
 
 namespace meshseek {
@@ -31,6 +35,7 @@ class BuildRunner {
   /// (they resume at the next start).
   BuildRunner(CoordinatorStore* store,
               Workers* workers,
+              LiveIndex* live,
               const CoordinatorOptions& options,
               const std::atomic<bool>* stop);
   ~BuildRunner();
@@ -39,7 +44,8 @@ class BuildRunner {
   /// FailedPrecondition while one runs, while models are pending, or with
   /// fewer than 2 extracted models.
   absl::StatusOr<std::string> Start(const std::string& collection);
-  /// Restarts the builds a restart interrupted.
+  /// Restarts the builds a restart interrupted, and catches up live
+  /// indexing of every other built collection (in the background).
   absl::Status ResumeInterrupted();
   /// Joins the build threads (after `stop` was set).
   void Join();
@@ -59,6 +65,7 @@ class BuildRunner {
 
   CoordinatorStore* const store_;
   Workers* const workers_;
+  LiveIndex* const live_;
   const CoordinatorOptions options_;
   const std::atomic<bool>* const stop_;
 

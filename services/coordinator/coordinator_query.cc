@@ -1,8 +1,10 @@
 // CoordinatorService: Query and Evaluate (coordinator_service.h). A
 // collection of one method without re-ranking is ranked by the index alone
 // (top-k merged over the shards, its own distances); a fused or re-ranked one
-// by its build's Ranking (ranking.h) over every part's distances.
+// by its build's Ranking (ranking.h), with the models that joined it live
+// (live_index.h), over every part's distances.
 #include <map>
+#include <optional>
 
 #include "absl/strings/str_cat.h"
 #include "common/base/parallel.h"
@@ -20,29 +22,6 @@ absl::Status Prefixed(const absl::Status& status, const std::string& prefix) {
 
 }  // namespace
 
-absl::StatusOr<std::shared_ptr<const Ranking>> CoordinatorService::RankingOf(
-    const CollectionPlan& plan) {
-  const std::string build = plan.build();
-  {
-    absl::MutexLock lock(&rankings_mutex_);
-    auto it = rankings_.find(plan.name);
-    if (it != rankings_.end() && it->second->build == build) return it->second;
-  }
-  MESHSEEK_ASSIGN_OR_RETURN(const std::optional<StoredRanking> stored,
-                            store_->GetRanking(plan.name));
-  if (!stored.has_value() || stored->build != build) {
-    return absl::FailedPreconditionError(absl::StrCat(
-        "collection '", plan.name, "' has no ranking state of build ", build, "; build it again"));
-  }
-  MESHSEEK_ASSIGN_OR_RETURN(RankingState state, RankingState::Parse(stored->state));
-  MESHSEEK_ASSIGN_OR_RETURN(Ranking ranking,
-                            Ranking::Make(stored->build, std::move(state), plan.options));
-  auto shared = std::make_shared<const Ranking>(std::move(ranking));
-  absl::MutexLock lock(&rankings_mutex_);
-  rankings_[plan.name] = shared;
-  return shared;
-}
-
 grpc::Status CoordinatorService::Query(grpc::ServerContext*,
                                        const v1::QueryRequest* request,
                                        v1::QueryResponse* response) {
@@ -54,6 +33,19 @@ grpc::Status CoordinatorService::Query(grpc::ServerContext*,
   if (plan->codebook_id.empty()) {
     return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
                         absl::StrCat("collection '", request->collection(), "' is not built yet"));
+  }
+  if (request->candidates() > 0) {
+    // Never ignored: a flag that cannot act is the caller's mistake.
+    const bool global = FeatureMethodInfoOf(plan->parts.front().options.extractor.method).kind ==
+                        DescriptorKind::kGlobal;
+    if (plan->options.rescaled() || global) {
+      return grpc::Status(
+          grpc::StatusCode::INVALID_ARGUMENT,
+          absl::StrCat("query: candidates=", request->candidates(), " does not apply to collection '",
+                       request->collection(), "' (",
+                       plan->options.rescaled() ? "fused or re-ranked" : "a global descriptor",
+                       ", ranked exactly); ask with candidates=0"));
+    }
   }
   v1::Mesh arrays;
   if (!request->model_id().empty()) {
@@ -128,33 +120,19 @@ grpc::Status CoordinatorService::Query(grpc::ServerContext*,
   }
 
   // Fused or re-ranked: every part's distances to every model, ranked by the
-  // build's state (`candidates` does not apply).
-  absl::StatusOr<std::shared_ptr<const Ranking>> ranking = RankingOf(*plan);
+  // build's state with the models that joined it since (live_index.h).
+  absl::StatusOr<std::shared_ptr<LiveRanking>> ranking = live_.RankingOf(*plan);
   if (!ranking.ok()) return rpc::ToGrpcStatus(ranking.status());
-  std::vector<std::vector<IndexShards::Scored>> distances(parts);
-  std::vector<absl::Status> errors(parts);
-  ParallelFor(parts, static_cast<int>(parts), [&](std::size_t p) {
-    const CollectionInfo& part = plan->parts[p];
-    v1::DistancesRequest ask;
-    ask.set_collection(part.name);
-    ask.set_kl_epsilon(part.options.kl.epsilon);
-    if (signatures[p]->descriptor.has_value()) {
-      *ask.add_global_queries() = *signatures[p]->descriptor;
-    } else {
-      *ask.add_queries() = signatures[p]->histogram;
-    }
-    absl::StatusOr<std::vector<IndexShards::Scored>> got = workers_.index()->QueryDistances(ask);
-    if (got.ok()) {
-      distances[p] = *std::move(got);
-    } else {
-      errors[p] = got.status();
-    }
-  });
-  for (const absl::Status& e : errors) {
-    if (!e.ok()) return rpc::ToGrpcStatus(e);
+  std::vector<const IndexSignature*> query(parts);
+  for (std::size_t p = 0; p < parts; ++p) query[p] = &*signatures[p];
+  absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> distances =
+      PartDistances(workers_.index(), *plan, query);
+  if (!distances.ok()) return rpc::ToGrpcStatus(distances.status());
+  absl::StatusOr<std::vector<v1::ScoredModel>> found;
+  {
+    absl::ReaderMutexLock lock(&(*ranking)->mutex);
+    found = (*ranking)->ranking.Query(*distances, plan->options, request->top_k());
   }
-  absl::StatusOr<std::vector<v1::ScoredModel>> found =
-      (*ranking)->Query(distances, plan->options, request->top_k());
   if (!found.ok()) return rpc::ToGrpcStatus(found.status());
   for (v1::ScoredModel& m : *found) *response->add_results() = std::move(m);
   return grpc::Status::OK;
@@ -180,11 +158,13 @@ grpc::Status CoordinatorService::Evaluate(grpc::ServerContext* context,
                                      collection->pending(),
                                      " pending; build it first"));
   }
-  std::shared_ptr<const Ranking> ranking;
+  // A copy: the stream is paced by the client, and joins must not wait.
+  std::optional<Ranking> ranking;
   if (plan->options.rescaled()) {
-    absl::StatusOr<std::shared_ptr<const Ranking>> loaded = RankingOf(*plan);
+    absl::StatusOr<std::shared_ptr<LiveRanking>> loaded = live_.RankingOf(*plan);
     if (!loaded.ok()) return rpc::ToGrpcStatus(loaded.status());
-    ranking = *std::move(loaded);
+    absl::ReaderMutexLock lock(&(*loaded)->mutex);
+    ranking = (*loaded)->ranking;
   }
   // Feature counts per model and part.
   const std::size_t parts = plan->parts.size();
@@ -212,7 +192,7 @@ grpc::Status CoordinatorService::Evaluate(grpc::ServerContext* context,
         if (context->IsCancelled()) return absl::CancelledError("evaluate: cancelled");
         out.set_model_id(row.model->model_id());
         out.set_label(row.model->label());
-        if (ranking == nullptr) {
+        if (!ranking.has_value()) {
           out.mutable_distances()->Assign(row.distances[0].begin(), row.distances[0].end());
         } else {
           // Rows come in node order: the build's order, unless the

@@ -72,6 +72,18 @@ constexpr const char* kSchema4 = R"sql(
     PRIMARY KEY (collection, model_id));
 )sql";
 
+// Version 5: live ingest (docs/design.md "Live ingest"). `live` marks a
+// model indexed with its collection's codebook after the build that trained
+// it (status counts them: added since the codebook); ranking_joins holds,
+// per fused or re-ranked collection, the models that joined its build's
+// ranking state since, in join order (seq), each a RankingJoin.
+constexpr const char* kSchema5 = R"sql(
+  ALTER TABLE models ADD COLUMN live INTEGER NOT NULL DEFAULT 0;
+  CREATE TABLE ranking_joins (
+    collection TEXT NOT NULL, seq INTEGER NOT NULL, build TEXT NOT NULL,
+    model_id TEXT NOT NULL, node BLOB NOT NULL, PRIMARY KEY (collection, seq));
+)sql";
+
 }  // namespace
 
 std::string MeshFingerprint(const std::string& mesh_bytes) {
@@ -94,6 +106,7 @@ absl::Status MigrateCoordinatorSchema(Database* db) {
     }
     if (to == 3) MESHSEEK_RETURN_IF_ERROR(db->Execute(kSchema3));
     if (to == 4) MESHSEEK_RETURN_IF_ERROR(db->Execute(kSchema4));
+    if (to == 5) MESHSEEK_RETURN_IF_ERROR(db->Execute(kSchema5));
     MESHSEEK_RETURN_IF_ERROR(db->SetUserVersion(to));
     MESHSEEK_RETURN_IF_ERROR(transaction.Commit());
     if (version > 0) MESHSEEK_LOG(INFO) << db->path() << ": schema migrated to version " << to;

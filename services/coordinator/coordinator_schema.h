@@ -21,7 +21,7 @@
 namespace meshseek {
 
 /// The schema version this code writes.
-inline constexpr int64_t kCoordinatorSchemaVersion = 4;
+inline constexpr int64_t kCoordinatorSchemaVersion = 5;
 
 /// Brings `db` to kCoordinatorSchemaVersion; FailedPrecondition for a newer
 /// one.

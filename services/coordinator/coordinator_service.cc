@@ -66,8 +66,9 @@ CoordinatorService::CoordinatorService(const CoordinatorOptions& options,
     : options_(options),
       store_(std::move(store)),
       workers_(options, &stop_),
-      dispatcher_(store_.get(), &workers_, options_, &stop_),
-      builds_(store_.get(), &workers_, options_, &stop_) {}
+      live_(store_.get(), &workers_),
+      dispatcher_(store_.get(), &workers_, &live_, options_, &stop_),
+      builds_(store_.get(), &workers_, &live_, options_, &stop_) {}
 
 absl::StatusOr<std::unique_ptr<CoordinatorService>> CoordinatorService::Create(
     const CoordinatorOptions& options) {
@@ -122,6 +123,7 @@ absl::StatusOr<v1::Collection> CoordinatorService::DescribeCollection(const std:
   collection.set_indexed(counts.indexed);
   collection.set_failed(counts.failed);
   collection.set_pending(counts.pending);
+  collection.set_added_since_build(counts.added);
   return collection;
 }
 

@@ -10,10 +10,12 @@
 //   coordinator_store    all durable state (SQLite): every SQL statement;
 //   index_shards         the index as one or more shards;
 //   workers              clients of the other services, deadlines, retries;
-//   dispatcher           PENDING models -> extract -> store (-> index);
-//   build_runner         build jobs: train, encode, index; resumable;
+//   dispatcher           PENDING models -> extract -> store (-> live index);
 //   ranking              fused and re-ranked collections: the state a build
 //                        leaves, queries and rows ranked with it;
+//   live_index           models extracted into a built collection: indexed
+//                        and joined to its ranking state without a build;
+//   build_runner         build jobs: train, encode, index; resumable;
 //   coordinator_service  the RPC handlers (this file): validate, delegate;
 //                        coordinator_query.cc holds Query and Evaluate.
 //
@@ -50,6 +52,7 @@
 #include "services/coordinator/coordinator_options.h"
 #include "services/coordinator/coordinator_store.h"
 #include "services/coordinator/dispatcher.h"
+#include "services/coordinator/live_index.h"
 #include "services/coordinator/ranking.h"
 #include "services/coordinator/workers.h"
 
@@ -106,8 +109,6 @@ class CoordinatorService final : public v1::Coordinator::Service {
   absl::StatusOr<v1::Collection> DescribeCollection(const std::string& name);
   // The plan of a collection clients may use: InvalidArgument for a member.
   absl::StatusOr<CollectionPlan> PublicPlan(const std::string& name);
-  // The ranking of a rescaled collection's last build, parsed once per build.
-  absl::StatusOr<std::shared_ptr<const Ranking>> RankingOf(const CollectionPlan& plan);
   // Ingest of one model: validates, stores, returns the ack.
   absl::StatusOr<v1::IngestAck> AcceptModel(const v1::IngestRequest& request,
                                             const std::vector<std::string>& parts,
@@ -117,11 +118,9 @@ class CoordinatorService final : public v1::Coordinator::Service {
   std::atomic<bool> stop_{false};
   std::unique_ptr<CoordinatorStore> store_;
   Workers workers_;
+  LiveIndex live_;
   Dispatcher dispatcher_;
   BuildRunner builds_;
-
-  absl::Mutex rankings_mutex_;
-  std::map<std::string, std::shared_ptr<const Ranking>> rankings_ ABSL_GUARDED_BY(rankings_mutex_);
   // Last: unregistered (waiting for a scrape in progress) before the store goes.
   std::unique_ptr<rpc::ScrapeGauge> models_gauge_;
 };

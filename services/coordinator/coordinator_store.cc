@@ -136,10 +136,11 @@ absl::StatusOr<ModelCounts> CoordinatorStore::CountModels(
       Statement count,
       db_->Prepare(absl::StrCat(
           "SELECT COUNT(*), SUM(failed = 0 AND pending), SUM(failed = 0 AND extracted), "
-          "SUM(failed), SUM(failed = 0 AND indexed) FROM (SELECT MAX(state = 2) AS failed, "
+          "SUM(failed), SUM(failed = 0 AND indexed), SUM(failed = 0 AND indexed AND live) "
+          "FROM (SELECT MAX(state = 2) AS failed, "
           "MAX(state = 0) AS pending, MIN(state = 1) AND COUNT(*) = ? AS extracted, "
           "MIN(state = 1 AND indexed_codebook = collection || '@' || ?) AND COUNT(*) = ? "
-          "AS indexed FROM models WHERE collection IN (",
+          "AS indexed, MAX(live) AS live FROM models WHERE collection IN (",
           in,
           ") GROUP BY model_id)")));
   count.Bind(1, static_cast<int64_t>(collections.size()))
@@ -155,30 +156,8 @@ absl::StatusOr<ModelCounts> CoordinatorStore::CountModels(
   counts.extracted = count.ColumnInt(2);
   counts.failed = count.ColumnInt(3);
   counts.indexed = build.empty() ? 0 : count.ColumnInt(4);
+  counts.added = build.empty() ? 0 : count.ColumnInt(5);
   return counts;
-}
-
-absl::Status CoordinatorStore::SetRanking(const std::string& collection,
-                                          const std::string& build,
-                                          const std::string& state) {
-  absl::MutexLock lock(&mutex_);
-  MESHSEEK_ASSIGN_OR_RETURN(
-      Statement upsert,
-      db_->Prepare("INSERT INTO rankings (collection, build, state) VALUES (?, ?, ?) "
-                   "ON CONFLICT (collection) DO UPDATE SET build = excluded.build, "
-                   "state = excluded.state"));
-  return upsert.Bind(1, collection).Bind(2, build).BindBlob(3, state).Run();
-}
-
-absl::StatusOr<std::optional<StoredRanking>> CoordinatorStore::GetRanking(
-    const std::string& collection) {
-  absl::MutexLock lock(&mutex_);
-  MESHSEEK_ASSIGN_OR_RETURN(Statement select,
-                            db_->Prepare("SELECT build, state FROM rankings WHERE collection = ?"));
-  select.Bind(1, collection);
-  MESHSEEK_ASSIGN_OR_RETURN(const bool found, select.Step());
-  if (!found) return std::nullopt;
-  return StoredRanking{select.ColumnText(0), select.ColumnBlob(1)};
 }
 
 // ----------------------------------------------------------------------- jobs

@@ -79,6 +79,7 @@ struct ModelCounts {
   uint64_t extracted = 0;
   uint64_t failed = 0;
   uint64_t indexed = 0;  // extracted and indexed with the given codebook
+  uint64_t added = 0;    // of those, indexed live: after the build trained it
 };
 
 /// What a dispatcher needs to extract one pending model.
@@ -97,6 +98,13 @@ struct ExtractedModel {
   std::string label;
   std::string features;  // serialized v1::LocalFeatures
   std::string indexed_codebook;
+};
+
+/// A model a ranking state holds, in node order.
+struct RankedModel {
+  std::string model_id;
+  uint64_t ordinal = 0;
+  std::string label;
 };
 
 class CoordinatorStore {
@@ -126,11 +134,26 @@ class CoordinatorStore {
   absl::StatusOr<ModelCounts> CountModels(const std::vector<std::string>& collections,
                                           const std::string& build);
   /// The ranking state of a fused or re-ranked collection, replacing the
-  /// previous build's.
+  /// previous build's (and the joins of that build).
   absl::Status SetRanking(const std::string& collection,
                           const std::string& build,
                           const std::string& state);
   absl::StatusOr<std::optional<StoredRanking>> GetRanking(const std::string& collection);
+  /// Appends a model's join (RankingJoin bytes) to the state of `build`;
+  /// false, and nothing stored, when the stored state is of another build
+  /// (a build ended meanwhile: its state ranks the model already).
+  absl::StatusOr<bool> AddRankingJoin(const std::string& collection,
+                                      const std::string& build,
+                                      const std::string& model_id,
+                                      const std::string& join);
+  /// The joins of `build`'s state, in join order.
+  absl::StatusOr<std::vector<std::string>> RankingJoins(const std::string& collection,
+                                                        const std::string& build);
+  /// The models indexed by `build` in every one of `collections` (one, or a
+  /// fused collection's members), in the first one's ingest order: those
+  /// that the build's ranking state, with its joins, should rank.
+  absl::StatusOr<std::vector<RankedModel>> IndexedModels(
+      const std::vector<std::string>& collections, const std::string& build);
 
   // ------------------------------------------------------------------- jobs
   /// A RUNNING job with id "<kind>-<sequence>"; an ingest job starts with its
@@ -203,7 +226,8 @@ class CoordinatorStore {
                              int attempts,
                              absl::Time retry_at,
                              const std::string& error);
-  absl::Status MarkIndexed(const ModelKey& key, const std::string& codebook_id);
+  /// `live`: by live ingest, after the build that trained the codebook.
+  absl::Status MarkIndexed(const ModelKey& key, const std::string& codebook_id, bool live = false);
   /// Deletes the model; its state before, or nullopt when there was none.
   absl::StatusOr<std::optional<ModelState>> RemoveModel(const ModelKey& key);
 
@@ -222,8 +246,13 @@ class CoordinatorStore {
   /// members), sorted.
   absl::StatusOr<std::vector<std::string>> ListCollectionNames();
 
-  /// Every EXTRACTED model of the collection in ingest order.
-  absl::StatusOr<std::vector<ExtractedModel>> ExtractedModels(const std::string& collection);
+  /// Every EXTRACTED model of the collection in ingest order; with
+  /// `not_indexed_with`, those not indexed with that codebook only (what
+  /// live indexing catches up with after a restart or a build).
+  absl::StatusOr<std::vector<ExtractedModel>> ExtractedModels(
+      const std::string& collection, const std::optional<std::string>& not_indexed_with = {});
+  /// One EXTRACTED model; nullopt when it is not (or no longer) extracted.
+  absl::StatusOr<std::optional<ExtractedModel>> LoadExtracted(const ModelKey& key);
   /// A page of the collection's models (see ListCollectionModelsRequest):
   /// of request.collection, or with `members` (a fused collection's) each
   /// model once, in the state CountModels gives it, with its members' errors

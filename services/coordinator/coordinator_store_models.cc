@@ -206,13 +206,19 @@ absl::Status CoordinatorStore::ScheduleRetry(const ModelKey& key,
       .Run();
 }
 
-absl::Status CoordinatorStore::MarkIndexed(const ModelKey& key, const std::string& codebook_id) {
+absl::Status CoordinatorStore::MarkIndexed(const ModelKey& key,
+                                           const std::string& codebook_id,
+                                           bool live) {
   absl::MutexLock lock(&mutex_);
   MESHSEEK_ASSIGN_OR_RETURN(
       Statement mark,
-      db_->Prepare("UPDATE models SET indexed_codebook = ? WHERE collection = ? "
+      db_->Prepare("UPDATE models SET indexed_codebook = ?, live = ? WHERE collection = ? "
                    "AND model_id = ?"));
-  return mark.Bind(1, codebook_id).Bind(2, key.collection).Bind(3, key.model_id).Run();
+  return mark.Bind(1, codebook_id)
+      .Bind(2, int64_t{live ? 1 : 0})
+      .Bind(3, key.collection)
+      .Bind(4, key.model_id)
+      .Run();
 }
 
 absl::StatusOr<std::optional<ModelState>> CoordinatorStore::RemoveModel(const ModelKey& key) {
@@ -233,24 +239,49 @@ absl::StatusOr<std::optional<ModelState>> CoordinatorStore::RemoveModel(const Mo
   return state;
 }
 
+namespace {
+
+constexpr const char* kSelectExtracted =
+    "SELECT model_id, ordinal, label, features, indexed_codebook FROM models "
+    "WHERE collection = ?1 AND state = 1";
+
+ExtractedModel ExtractedRow(const Statement& select) {
+  return {select.ColumnText(0),
+          static_cast<uint64_t>(select.ColumnInt(1)),
+          select.ColumnText(2),
+          select.ColumnBlob(3),
+          select.ColumnText(4)};
+}
+
+}  // namespace
+
 absl::StatusOr<std::vector<ExtractedModel>> CoordinatorStore::ExtractedModels(
-    const std::string& collection) {
+    const std::string& collection, const std::optional<std::string>& not_indexed_with) {
   absl::MutexLock lock(&mutex_);
   MESHSEEK_ASSIGN_OR_RETURN(
       Statement select,
-      db_->Prepare("SELECT model_id, ordinal, label, features, indexed_codebook FROM models "
-                   "WHERE collection = ? AND state = 1 ORDER BY ordinal"));
+      db_->Prepare(absl::StrCat(kSelectExtracted,
+                                not_indexed_with.has_value() ? " AND indexed_codebook != ?2" : "",
+                                " ORDER BY ordinal")));
   select.Bind(1, collection);
+  if (not_indexed_with.has_value()) select.Bind(2, *not_indexed_with);
   std::vector<ExtractedModel> models;
   while (true) {
     MESHSEEK_ASSIGN_OR_RETURN(const bool row, select.Step());
     if (!row) return models;
-    models.push_back({select.ColumnText(0),
-                      static_cast<uint64_t>(select.ColumnInt(1)),
-                      select.ColumnText(2),
-                      select.ColumnBlob(3),
-                      select.ColumnText(4)});
+    models.push_back(ExtractedRow(select));
   }
+}
+
+absl::StatusOr<std::optional<ExtractedModel>> CoordinatorStore::LoadExtracted(
+    const ModelKey& key) {
+  absl::MutexLock lock(&mutex_);
+  MESHSEEK_ASSIGN_OR_RETURN(Statement select,
+                            db_->Prepare(absl::StrCat(kSelectExtracted, " AND model_id = ?2")));
+  select.Bind(1, key.collection).Bind(2, key.model_id);
+  MESHSEEK_ASSIGN_OR_RETURN(const bool found, select.Step());
+  if (!found) return std::nullopt;
+  return ExtractedRow(select);
 }
 
 absl::StatusOr<v1::ListCollectionModelsResponse> CoordinatorStore::ListModels(

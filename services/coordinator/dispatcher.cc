@@ -34,9 +34,10 @@ absl::Duration RetryBackoff(const CoordinatorOptions& options, int attempts) {
 
 Dispatcher::Dispatcher(CoordinatorStore* store,
                        Workers* workers,
+                       LiveIndex* live,
                        const CoordinatorOptions& options,
                        const std::atomic<bool>* stop)
-    : store_(store), workers_(workers), options_(options), stop_(stop) {}
+    : store_(store), workers_(workers), live_(live), options_(options), stop_(stop) {}
 
 Dispatcher::~Dispatcher() { Join(); }
 
@@ -173,19 +174,13 @@ void Dispatcher::Process(const ModelKey& key) {
     }
     return;
   }
-  // A built collection ranked by the index alone: index the new model with
-  // the current codebook. A fused or re-ranked one ranks the models of its
-  // last build (ranking.h): the new one waits for the next.
-  if (info->codebook_id.empty() || plan->member || plan->options.rescaled()) return;
-  absl::StatusOr<IndexSignature> signature = workers_->Encode(*info, info->codebook_id, *features);
-  absl::Status added =
-      signature.ok() ? workers_->AddToIndex(
-                           key.collection, key.model_id, model.ordinal, model.label, *signature)
-                     : signature.status();
-  if (added.ok()) added = store_->MarkIndexed(key, info->codebook_id);
-  if (!added.ok()) {
+  // A built collection: searchable now, without a build (live_index.h).
+  if (absl::Status live = live_->ModelExtracted(key, *features, model.ordinal, model.label);
+      !live.ok()) {
     MESHSEEK_LOG(WARNING) << "coordinator: model " << key.model_id
-                          << " extracted but not indexed (build again): " << added;
+                          << " extracted but not yet searchable (retried at the next start or "
+                             "build): "
+                          << live;
   }
 }
 

@@ -1,7 +1,7 @@
 // The coordinator's dispatchers: `max_in_flight` threads that take PENDING
 // models from the store (no in-memory queue: after a restart they simply
 // continue) and run resample -> extract -> store features, and, when the
-// collection already has a codebook, encode -> index.
+// collection has been built, encode -> index -> rank (live_index.h).
 //
 // Failures (CoordinatorOptions::model_attempts):
 //   - a permanent error (INVALID_ARGUMENT, DATA_LOSS, FAILED_PRECONDITION:
@@ -29,6 +29,7 @@
 #include "absl/time/time.h"
 #include "services/coordinator/coordinator_options.h"
 #include "services/coordinator/coordinator_store.h"
+#include "services/coordinator/live_index.h"
 #include "services/coordinator/workers.h"
 
 namespace meshseek {
@@ -44,6 +45,7 @@ class Dispatcher {
   /// Not owned; all must outlive the dispatcher. `stop` ends the loops.
   Dispatcher(CoordinatorStore* store,
              Workers* workers,
+             LiveIndex* live,
              const CoordinatorOptions& options,
              const std::atomic<bool>* stop);
   ~Dispatcher();
@@ -69,6 +71,7 @@ class Dispatcher {
 
   CoordinatorStore* const store_;
   Workers* const workers_;
+  LiveIndex* const live_;
   const CoordinatorOptions options_;
   const std::atomic<bool>* const stop_;
 

@@ -85,7 +85,8 @@ TEST(DispatcherTest, ModelsEndExtractedOrFailedWithTheirReasonAndThenAllIsIdle) 
 
   std::atomic<bool> stop{false};
   Workers workers(options, &stop);
-  Dispatcher dispatcher(store->get(), &workers, options, &stop);
+  LiveIndex live(store->get(), &workers);
+  Dispatcher dispatcher(store->get(), &workers, &live, options, &stop);
   const absl::Time start = absl::Now();
   dispatcher.Start();
   while ((*store)->PendingCount() > 0 && absl::Now() - start < absl::Seconds(20)) {

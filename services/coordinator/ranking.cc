@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/base/byte_order.h"
 #include "common/base/hash.h"
+#include "common/base/parallel.h"
 #include "common/base/status_macros.h"
 #include "common/search/fusion.h"
 #include "common/search/rerank.h"
@@ -17,6 +18,7 @@ namespace meshseek {
 namespace {
 
 constexpr char kMagic[4] = {'M', 'S', 'R', 'S'};
+constexpr char kJoinMagic[4] = {'M', 'S', 'R', 'J'};
 constexpr uint32_t kVersion = 1;
 constexpr std::size_t kMaxText = 1 << 16;  // ids and labels are far shorter
 
@@ -63,7 +65,85 @@ class Reader {
   std::size_t at_ = 0;
 };
 
+void PutNeighbors(const std::vector<GraphNeighbor>& list, std::string* out) {
+  PutLittleEndian(list.size(), 4, out);
+  for (const GraphNeighbor& e : list) {
+    PutLittleEndian(e.node, 4, out);
+    PutFloat(e.distance, out);
+  }
+}
+
+bool ReadNeighbors(Reader* in, std::vector<GraphNeighbor>* list) {
+  uint64_t size = 0;
+  if (!in->Int(4, &size) || size > in->left() / 8) return false;
+  list->resize(size);
+  for (GraphNeighbor& e : *list) {
+    uint64_t node = 0;
+    absl::string_view distance;
+    if (!in->Int(4, &node) || !in->Bytes(4, &distance)) return false;
+    e = GraphNeighbor{static_cast<uint32_t>(node), GetFloat(distance.data())};
+  }
+  return true;
+}
+
+// The query's (or joining model's) distance to every node from each part's
+// answers: +inf where a part did not answer; per node, how many parts did.
+std::vector<std::vector<float>> NodeRows(
+    const absl::flat_hash_map<std::string, uint32_t>& node_of,
+    std::size_t n,
+    const std::vector<std::vector<IndexShards::Scored>>& part_distances,
+    std::vector<uint8_t>* answered) {
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<std::vector<float>> rows(part_distances.size(), std::vector<float>(n, inf));
+  answered->assign(n, 0);
+  for (std::size_t p = 0; p < part_distances.size(); ++p) {
+    for (const IndexShards::Scored& s : part_distances[p]) {
+      auto it = node_of.find(s.model_id);
+      if (it == node_of.end()) continue;  // not (yet) in the state
+      rows[p][it->second] = s.distance;
+      (*answered)[it->second] += 1;
+    }
+  }
+  return rows;
+}
+
 }  // namespace
+
+std::string RankingJoin::Serialize() const {
+  std::string out(kJoinMagic, sizeof(kJoinMagic));
+  PutLittleEndian(kVersion, 4, &out);
+  PutText(model_id, &out);
+  PutLittleEndian(ordinal, 8, &out);
+  PutText(label, &out);
+  PutNeighbors(graph.list, &out);
+  PutNeighbors(graph.entered, &out);
+  PutLittleEndian(Fnv1a64(out), 8, &out);
+  return out;
+}
+
+absl::StatusOr<RankingJoin> RankingJoin::Parse(absl::string_view bytes) {
+  const auto bad = [](const auto&... what) {
+    return absl::DataLossError(absl::StrCat("ranking join: ", what...));
+  };
+  if (bytes.size() < sizeof(kJoinMagic) + 8 ||
+      std::memcmp(bytes.data(), kJoinMagic, sizeof(kJoinMagic)) != 0) {
+    return bad("not a ranking join (", bytes.size(), " bytes)");
+  }
+  const std::size_t body = bytes.size() - 8;
+  if (Fnv1a64(bytes.substr(0, body)) != GetLittleEndian(bytes.data() + body, 8)) {
+    return bad("checksum mismatch");
+  }
+  Reader in(bytes.substr(sizeof(kJoinMagic), body - sizeof(kJoinMagic)));
+  uint64_t version = 0;
+  RankingJoin join;
+  if (!in.Int(4, &version) || version != kVersion) return bad("unsupported version ", version);
+  if (!in.Text(&join.model_id) || !in.Int(8, &join.ordinal) || !in.Text(&join.label) ||
+      !ReadNeighbors(&in, &join.graph.list) || !ReadNeighbors(&in, &join.graph.entered)) {
+    return bad("cut short");
+  }
+  if (in.left() != 0) return bad(in.left(), " bytes after the end");
+  return join;
+}
 
 std::string RankingState::Serialize() const {
   std::string out(kMagic, sizeof(kMagic));
@@ -151,6 +231,7 @@ absl::StatusOr<Ranking> Ranking::Make(std::string build,
   }
   Ranking ranking;
   ranking.build = std::move(build);
+  ranking.graph_k = options.rerank.enabled() ? options.rerank.graph_k() : 0;
   MESHSEEK_ASSIGN_OR_RETURN(ranking.factors, FusionFactors(options.weights, state.scales));
   for (uint32_t i = 0; i < state.model_ids.size(); ++i) ranking.node_of[state.model_ids[i]] = i;
   ranking.state = std::move(state);
@@ -183,22 +264,56 @@ absl::StatusOr<std::vector<float>> Ranking::RankRow(
   return RerankRow(*state.graph, fused, self, options.rerank);
 }
 
+absl::StatusOr<RankingJoin> Ranking::PlanJoin(
+    const std::string& model_id,
+    uint64_t ordinal,
+    const std::string& label,
+    const std::vector<std::vector<IndexShards::Scored>>& part_distances) const {
+  if (node_of.contains(model_id)) {
+    return absl::AlreadyExistsError(absl::StrCat("model ", model_id, " is ranked already"));
+  }
+  if (part_distances.size() != factors.size()) {
+    return absl::InternalError(
+        absl::StrCat(part_distances.size(), " parts for ", factors.size(), " methods"));
+  }
+  RankingJoin join{model_id, ordinal, label, {}};
+  if (!state.graph.has_value()) return join;
+  const std::size_t n = state.model_ids.size();
+  std::vector<uint8_t> answered;
+  const std::vector<std::vector<float>> rows = NodeRows(node_of, n, part_distances, &answered);
+  std::vector<absl::Span<const float>> spans(rows.begin(), rows.end());
+  std::vector<float> fused(n);
+  FuseRows(spans, factors, absl::MakeSpan(fused));
+  join.graph = state.graph->PlanJoin(fused, graph_k);
+  return join;
+}
+
+absl::Status Ranking::Apply(const RankingJoin& join) {
+  if (node_of.contains(join.model_id)) {
+    return absl::DataLossError(absl::StrCat("ranking join of ", join.model_id, ", ranked already"));
+  }
+  if (state.graph.has_value()) {
+    if (absl::Status s = state.graph->ApplyJoin(join.graph); !s.ok()) {
+      return absl::DataLossError(absl::StrCat("ranking join of ", join.model_id, ": ", s.message()));
+    }
+  } else if (!join.graph.list.empty() || !join.graph.entered.empty()) {
+    return absl::DataLossError(
+        absl::StrCat("ranking join of ", join.model_id, " changes a graph the state has not"));
+  }
+  node_of[join.model_id] = static_cast<uint32_t>(state.model_ids.size());
+  state.model_ids.push_back(join.model_id);
+  state.ordinals.push_back(join.ordinal);
+  state.labels.push_back(join.label);
+  return absl::OkStatus();
+}
+
 absl::StatusOr<std::vector<v1::ScoredModel>> Ranking::Query(
     const std::vector<std::vector<IndexShards::Scored>>& part_distances,
     const CollectionOptions& options,
     std::size_t top_k) const {
   const std::size_t n = state.model_ids.size();
-  const float inf = std::numeric_limits<float>::infinity();
-  std::vector<std::vector<float>> rows(part_distances.size(), std::vector<float>(n, inf));
-  std::vector<uint8_t> answered(n, 0);
-  for (std::size_t p = 0; p < part_distances.size(); ++p) {
-    for (const IndexShards::Scored& s : part_distances[p]) {
-      auto it = node_of.find(s.model_id);
-      if (it == node_of.end()) continue;  // ingested after the build
-      rows[p][it->second] = s.distance;
-      answered[it->second] += 1;
-    }
-  }
+  std::vector<uint8_t> answered;
+  const std::vector<std::vector<float>> rows = NodeRows(node_of, n, part_distances, &answered);
   std::vector<absl::Span<const float>> spans(rows.begin(), rows.end());
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<float> ranked, RankRow(spans, std::nullopt, options));
   std::vector<uint32_t> nodes;
@@ -220,6 +335,37 @@ absl::StatusOr<std::vector<v1::ScoredModel>> Ranking::Query(
     results[r].set_ordinal(state.ordinals[i]);
   }
   return results;
+}
+
+absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> PartDistances(
+    IndexShards* index,
+    const CollectionPlan& plan,
+    const std::vector<const IndexSignature*>& signatures) {
+  const std::size_t parts = plan.parts.size();
+  if (signatures.size() != parts) {
+    return absl::InternalError(absl::StrCat(signatures.size(), " signatures for ", parts, " parts"));
+  }
+  std::vector<std::vector<IndexShards::Scored>> distances(parts);
+  std::vector<absl::Status> errors(parts);
+  ParallelFor(parts, static_cast<int>(parts), [&](std::size_t p) {
+    const CollectionInfo& part = plan.parts[p];
+    v1::DistancesRequest ask;
+    ask.set_collection(part.name);
+    ask.set_kl_epsilon(part.options.kl.epsilon);
+    if (signatures[p]->descriptor.has_value()) {
+      *ask.add_global_queries() = *signatures[p]->descriptor;
+    } else {
+      *ask.add_queries() = signatures[p]->histogram;
+    }
+    absl::StatusOr<std::vector<IndexShards::Scored>> got = index->QueryDistances(ask);
+    if (got.ok()) {
+      distances[p] = *std::move(got);
+    } else {
+      errors[p] = got.status();
+    }
+  });
+  for (const absl::Status& e : errors) MESHSEEK_RETURN_IF_ERROR(e);
+  return distances;
 }
 
 std::vector<IndexShards::Part> IndexParts(const CollectionPlan& plan) {

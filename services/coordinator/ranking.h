@@ -10,8 +10,11 @@
 // ordinals, and, when re-ranked, the neighbour graph of the fused distances.
 // Queries then need no more than each part's distances to every model:
 // fused with the stored scales and re-ranked against the stored graph, the
-// query joining it (rerank.h). Models ingested after the build are not in
-// the state and wait for the next build; a model removed since ranks nowhere.
+// query joining it (rerank.h). A model ingested after the build joins the
+// state for good once every part has indexed it (live ingest: a RankingJoin,
+// stored beside the state and replayed on load, docs/design.md "Live
+// ingest"): the next node, fused with the build's scales, entering the graph
+// as a query would; a model removed since ranks nowhere.
 //
 // Cost of a build's ranking step: two passes over the parts' distances, the
 // sample rows then all rows (O(N^2) distances, in blocks of IndexShards'
@@ -54,12 +57,29 @@ struct RankingState {
   static absl::StatusOr<RankingState> Parse(absl::string_view bytes);
 };
 
+/// A model that joined a built state (live ingest): the next node, and what
+/// it changed in the graph (re-ranked collections; empty otherwise).
+struct RankingJoin {
+  std::string model_id;
+  uint64_t ordinal = 0;
+  std::string label;
+  GraphJoin graph;
+
+  /// "MSRJ" | uint32 version (1) | id, uint64 ordinal, label (as in the
+  /// state) | uint32 list length, (uint32 node, float32 distance)... |
+  /// uint32 entered count, (uint32, float32)... | FNV-1a 64.
+  std::string Serialize() const;
+  /// DataLoss naming what is wrong for bytes that are not a join.
+  static absl::StatusOr<RankingJoin> Parse(absl::string_view bytes);
+};
+
 /// A parsed state ready for queries: node of each model id, fusion factors.
 struct Ranking {
   std::string build;
   RankingState state;
   absl::flat_hash_map<std::string, uint32_t> node_of;
   std::vector<double> factors;  // FusionFactors(weights, scales)
+  int graph_k = 0;              // the lists re-ranking asks of the graph
 
   static absl::StatusOr<Ranking> Make(std::string build,
                                       RankingState state,
@@ -71,6 +91,20 @@ struct Ranking {
   absl::StatusOr<std::vector<float>> RankRow(const std::vector<absl::Span<const float>>& part_rows,
                                              std::optional<uint32_t> self,
                                              const CollectionOptions& options) const;
+
+  /// The join of a model not yet in the state from each part's distances to
+  /// every model (as QueryDistances answered them; its own distance and
+  /// those of models not in the state are ignored, models that a part did
+  /// not answer are +inf). AlreadyExists when the model is a node.
+  absl::StatusOr<RankingJoin> PlanJoin(
+      const std::string& model_id,
+      uint64_t ordinal,
+      const std::string& label,
+      const std::vector<std::vector<IndexShards::Scored>>& part_distances) const;
+  /// Appends the join's model as the next node (and its graph changes).
+  /// DataLoss for a join that does not fit this state (a stored join of
+  /// another state, or damaged).
+  absl::Status Apply(const RankingJoin& join);
 
   /// A query's top_k from each part's distances to every model (as the index
   /// answered them): models of the build answered by every part, by
@@ -84,6 +118,13 @@ struct Ranking {
 /// The state of `plan` after a build indexed every part: scales over the
 /// sample rows, then the graph of every fused row (re-ranked collections).
 absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index, const CollectionPlan& plan);
+
+/// Each part's distances from its signature (one per part, in part order)
+/// to every model of the part, the parts asked at once.
+absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> PartDistances(
+    IndexShards* index,
+    const CollectionPlan& plan,
+    const std::vector<const IndexSignature*>& signatures);
 
 /// The parts of `plan` as IndexShards parts.
 std::vector<IndexShards::Part> IndexParts(const CollectionPlan& plan);

@@ -86,5 +86,44 @@ TEST(RankingTest, ReRankedCollectionsNeedTheirGraph) {
             absl::StatusCode::kFailedPrecondition);
 }
 
+// Live ingest: a model joins as the next node, fused with the build's scales,
+// its graph changes stored and replayed; then queries rank it.
+TEST(RankingTest, AJoinedModelIsTheNextNodeAndReplaysFromItsBytes) {
+  const CollectionOptions options =
+      CollectionOptions::ForMethods({FeatureMethod::kDldSift, FeatureMethod::kLfd});
+  auto ranking = Ranking::Make("b", LineState(true), options);
+  ASSERT_TRUE(ranking.ok()) << ranking.status();
+  // "d" at 4.5: scaled distances 4.5/2 .. and 45/20 .. to a, b, c.
+  const std::vector<std::vector<IndexShards::Scored>> distances = {
+      {{"a", 4.5f}, {"b", 3.5f}, {"c", 0.5f}, {"d", 0.0f}},
+      {{"a", 45.0f}, {"b", 35.0f}, {"c", 5.0f}, {"d", 0.0f}}};
+  auto join = ranking->PlanJoin("d", 7, "y", distances);
+  ASSERT_TRUE(join.ok()) << join.status();
+  EXPECT_EQ(join->graph.list.front().node, 3u);
+  EXPECT_EQ(join->graph.list[1].node, 2u);  // c is nearest
+  auto back = RankingJoin::Parse(join->Serialize());
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->model_id, "d");
+  EXPECT_EQ(back->ordinal, 7u);
+  EXPECT_EQ(back->graph.list, join->graph.list);
+  EXPECT_EQ(back->graph.entered, join->graph.entered);
+  std::string damaged = join->Serialize();
+  damaged[6] ^= 1;
+  EXPECT_EQ(RankingJoin::Parse(damaged).status().code(), absl::StatusCode::kDataLoss);
+
+  ASSERT_TRUE(ranking->Apply(*back).ok());
+  EXPECT_EQ(ranking->PlanJoin("d", 7, "y", distances).status().code(),
+            absl::StatusCode::kAlreadyExists);
+  EXPECT_EQ(ranking->Apply(*back).code(), absl::StatusCode::kDataLoss);
+  EXPECT_EQ(ranking->state.graph->size(), 4u);
+  // c's list now holds d (nearer than a).
+  EXPECT_EQ(ranking->state.graph->Of(2)[1].node, 3u);
+  // Queried with d's own distances, d comes first.
+  auto top = ranking->Query(distances, options, 2);
+  ASSERT_TRUE(top.ok()) << top.status();
+  EXPECT_EQ((*top)[0].model_id(), "d");
+  EXPECT_EQ((*top)[0].ordinal(), 7u);
+}
+
 }  // namespace
 }  // namespace meshseek
