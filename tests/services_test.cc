@@ -780,6 +780,30 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
     EXPECT_THAT(refused.error_message(), HasSubstr("candidates=10 does not apply"));
   }
 
+  // Bounded storage: each mesh once, and no features kept once a model is
+  // indexed and ranked (the build extracts them again from the meshes).
+  const auto stored = [&](const std::string& what) {
+    auto db = Database::Open(*dir_ + "/fused/coordinator/coordinator.db");
+    EXPECT_TRUE(db.ok()) << db.status();
+    auto select = (*db)->Prepare(absl::StrCat("SELECT ", what, " FROM models"));
+    EXPECT_TRUE(select.ok() && select->Run().ok());
+    return select->ColumnInt(0);
+  };
+  EXPECT_EQ(stored("COALESCE(SUM(length(features)), 0)"), 0);
+  EXPECT_EQ(stored("SUM(length(mesh) > 0)"), static_cast<int64_t>(n + 1));
+  EXPECT_EQ(stored("COUNT(*)"), static_cast<int64_t>(2 * (n + 1)));
+  // A rebuild (features extracted again, the live model trained on too)
+  // gives the in-process matrix of every model, bit for bit.
+  {
+    const std::vector<ManifestEntry> grown(models_->begin(), models_->begin() + n + 1);
+    auto rebuilt = EvaluateCollection(grown, in_process);
+    ASSERT_TRUE(rebuilt.ok()) << rebuilt.status();
+    const v1::JobStatus again = WaitJob(stub.get(), Build(stub.get(), "fused"));
+    ASSERT_EQ(again.state(), v1::JOB_STATE_SUCCEEDED) << again.DebugString();
+    EXPECT_EQ(Evaluate(stub.get(), "fused", n + 1), rebuilt->distances);
+    EXPECT_EQ(stored("COALESCE(SUM(length(features)), 0)"), 0);
+  }
+
   // A model queried joins the graph beside its stored copy: that copy first.
   v1::QueryResponse response;
   grpc::Status status = Query(stub.get(), "fused", 4, 3, absl::Seconds(60), &response);

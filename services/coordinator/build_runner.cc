@@ -178,15 +178,23 @@ absl::Status BuildRunner::BuildPart(const std::string& job_id,
         members.end());
   }
   // Parsed once, for training and encoding; the stored bytes are let go.
+  // Models indexed by an earlier build have had theirs freed: extracted
+  // again from their meshes, on the extract workers.
   std::vector<v1::LocalFeatures> features(members.size());
-  for (std::size_t i = 0; i < members.size(); ++i) {
+  std::vector<absl::Status> loaded(members.size());
+  ParallelFor(members.size(), options_.max_in_flight, [&](std::size_t i) {
+    if (*stop_) return;
     ExtractedModel& m = members[i];
-    if (!features[i].ParseFromString(m.features)) {
-      return absl::DataLossError(
-          absl::StrCat("model ", m.model_id, ": stored features do not parse"));
+    absl::StatusOr<v1::LocalFeatures> got = workers_->FeaturesOf(store_, part, m);
+    if (got.ok()) {
+      features[i] = *std::move(got);
+    } else {
+      loaded[i] = got.status();
     }
     std::string().swap(m.features);
-  }
+  });
+  if (*stop_) return absl::CancelledError("stopping");
+  for (const absl::Status& s : loaded) MESHSEEK_RETURN_IF_ERROR(s);
   // 1. The codebook, unless a resumed build trained it already or the method
   // is global (then the id only names this generation of the index).
   const bool global =
@@ -280,6 +288,8 @@ void BuildRunner::Run(const std::string& job_id, const std::string& collection) 
     absl::StrAppend(&message, "; ", failed, " failed models left out (meshseek status --collection ",
                     collection, " lists them)");
   }
+  // Indexed (and ranked): their features are not read before the next build.
+  if (absl::Status s = store_->DropFeatures(plan->PartNames(), job_id); !s.ok()) return fail(s);
   (void)store_->FinishJob(job_id, v1::JOB_STATE_SUCCEEDED, message);
   Done(collection);
   // Models extracted while the build ran: indexed with the new codebooks now.

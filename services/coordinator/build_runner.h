@@ -1,6 +1,7 @@
-// Build jobs: train the codebook on every extracted model's stored
-// descriptors, in ingest order (the same input as the in-process pipeline),
-// then encode and index every model; for a fused collection, each member in
+// Build jobs: train the codebook on every extracted model's descriptors
+// (stored since extraction, or extracted again from the mesh for models an
+// earlier build indexed), in ingest order (the same input as the in-process
+// pipeline), then encode and index every model; for a fused collection, each member in
 // turn (the models every method extracted), then, for a fused or re-ranked
 // collection, its ranking state (ranking.h). The codebook id is derived from the job
 // ("<collection>@<job>") and each model records the codebook it was indexed

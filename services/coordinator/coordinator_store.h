@@ -2,7 +2,8 @@
 // lives here. One SQLite file (coordinator.db) under the data folder holds
 //   collections (name, parameters, current codebook),
 //   models      (mesh, label, ingest ordinal, state, attempts, error,
-//                stored local features, the codebook it was indexed with),
+//                local features until indexed, the codebook it was indexed
+//                with),
 //   jobs        (ingest and build jobs and their state),
 //   thumbnails  (a PNG per model, under the collection clients name),
 //   rankings    (what the build of a fused or re-ranked collection leaves for
@@ -10,9 +11,16 @@
 //   settings    (facts fixed at first use: the number of index shards).
 //
 // A fused collection ("a+b") holds no models itself: its member collections
-// ("<name>~a", "<name>~b") hold a copy of each, extracted and indexed by
-// their method; the calls below take the member names where they count or
-// list a fused collection's models.
+// ("<name>~a", "<name>~b") hold a row of each, extracted and indexed by
+// their method (the mesh stored once, in the first member's row); the calls
+// below take the member names where they count or list a fused collection's
+// models.
+//
+// Bounded storage: a model's local features are kept from its extraction
+// until it is indexed (and, in a rescaled collection, ranked), then freed
+// (DropFeatures); a build extracts again what it trains on from the mesh.
+// What stays per model beyond its mesh is its row, thumbnail and, in the
+// index, its histograms (docs/design.md "Bounded storage").
 //
 // The schema and its versions: coordinator_schema.h.
 //
@@ -232,7 +240,8 @@ class CoordinatorStore {
   absl::StatusOr<std::optional<ModelState>> RemoveModel(const ModelKey& key);
 
   /// The mesh (serialized v1::Mesh) a model was ingested with, in any
-  /// state; nullopt when the collection has no such model.
+  /// state; nullopt when the collection has no such model. A fused
+  /// collection stores it once, in its first member's row.
   absl::StatusOr<std::optional<std::string>> ModelMesh(const ModelKey& key);
 
   // ------------------------------------------------------------- thumbnails
@@ -251,6 +260,13 @@ class CoordinatorStore {
   /// live indexing catches up with after a restart or a build).
   absl::StatusOr<std::vector<ExtractedModel>> ExtractedModels(
       const std::string& collection, const std::optional<std::string>& not_indexed_with = {});
+  /// Frees the stored features of the models indexed by `build` in
+  /// `collections` (one, or a fused collection's members; all of them, or
+  /// only `model_id`): once a model is indexed (and ranked), nothing reads
+  /// them before the next build, which extracts them again from the mesh.
+  absl::Status DropFeatures(const std::vector<std::string>& collections,
+                            const std::string& build,
+                            const std::string& model_id = "");
   /// One EXTRACTED model; nullopt when it is not (or no longer) extracted.
   absl::StatusOr<std::optional<ExtractedModel>> LoadExtracted(const ModelKey& key);
   /// A page of the collection's models (see ListCollectionModelsRequest):
@@ -264,6 +280,8 @@ class CoordinatorStore {
   explicit CoordinatorStore(std::unique_ptr<Database> db) : db_(std::move(db)) {}
   absl::Status Migrate(int index_shards) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   absl::Status FinishIngestJobIfDone(const std::string& job_id)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  absl::StatusOr<std::optional<std::string>> MeshInRows(const ModelKey& key)
       ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   absl::StatusOr<bool> EndPending(const ModelKey& key,
                                   ModelState state,

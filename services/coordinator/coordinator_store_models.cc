@@ -33,6 +33,9 @@ absl::StatusOr<CoordinatorStore::AddedModel> CoordinatorStore::AddModel(
   MESHSEEK_ASSIGN_OR_RETURN(Transaction transaction, Transaction::Begin(db_.get()));
   std::optional<AddedModel> result;
   for (const std::string& collection : collections) {
+    // The mesh once: in the first collection's row (a fused collection's
+    // first member); the others find it there (MeshInRows).
+    const std::string& stored_mesh = &collection == &collections.front() ? mesh : std::string();
     MESHSEEK_ASSIGN_OR_RETURN(Statement existing,
                               db_->Prepare("SELECT fingerprint, label, job_id FROM models "
                                            "WHERE collection = ? AND model_id = ?"));
@@ -59,7 +62,7 @@ absl::StatusOr<CoordinatorStore::AddedModel> CoordinatorStore::AddModel(
     MESHSEEK_RETURN_IF_ERROR(insert.Bind(1, collection)
                                  .Bind(2, model_id)
                                  .Bind(3, label)
-                                 .BindBlob(4, mesh)
+                                 .BindBlob(4, stored_mesh)
                                  .Bind(5, fingerprint)
                                  .Bind(6, job_id)
                                  .Run());
@@ -117,6 +120,10 @@ absl::StatusOr<std::optional<PendingModel>> CoordinatorStore::LoadPending(const 
   if (!found) return std::nullopt;
   PendingModel model;
   model.mesh = select.ColumnBlob(0);
+  if (model.mesh.empty()) {
+    MESHSEEK_ASSIGN_OR_RETURN(std::optional<std::string> mesh, MeshInRows(key));
+    model.mesh = std::move(mesh).value_or("");
+  }
   model.ordinal = static_cast<uint64_t>(select.ColumnInt(1));
   model.label = select.ColumnText(2);
   model.attempts = static_cast<int>(select.ColumnInt(3));
@@ -271,6 +278,25 @@ absl::StatusOr<std::vector<ExtractedModel>> CoordinatorStore::ExtractedModels(
     if (!row) return models;
     models.push_back(ExtractedRow(select));
   }
+}
+
+absl::Status CoordinatorStore::DropFeatures(const std::vector<std::string>& collections,
+                                           const std::string& build,
+                                           const std::string& model_id) {
+  absl::MutexLock lock(&mutex_);
+  std::string in;
+  for (std::size_t i = 0; i < collections.size(); ++i) absl::StrAppend(&in, ", ?", i + 3);
+  MESHSEEK_ASSIGN_OR_RETURN(
+      Statement drop,
+      db_->Prepare(absl::StrCat("UPDATE models SET features = NULL WHERE collection IN (",
+                                in.substr(2),
+                                ") AND state = 1 AND features IS NOT NULL AND indexed_codebook = "
+                                "collection || '@' || ?1 AND (?2 = '' OR model_id = ?2)")));
+  drop.Bind(1, build).Bind(2, model_id);
+  for (std::size_t i = 0; i < collections.size(); ++i) {
+    drop.Bind(static_cast<int>(i) + 3, collections[i]);
+  }
+  return drop.Run();
 }
 
 absl::StatusOr<std::optional<ExtractedModel>> CoordinatorStore::LoadExtracted(

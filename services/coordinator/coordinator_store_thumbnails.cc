@@ -7,10 +7,25 @@ namespace meshseek {
 
 absl::StatusOr<std::optional<std::string>> CoordinatorStore::ModelMesh(const ModelKey& key) {
   absl::MutexLock lock(&mutex_);
+  return MeshInRows(key);
+}
+
+absl::StatusOr<std::optional<std::string>> CoordinatorStore::MeshInRows(const ModelKey& key) {
+  // The row itself, or for a fused collection's member its sibling members'
+  // rows: names "<fused>~<method>" sort in ["<fused>~", "<fused>~~") as
+  // methods are lower-case letters.
+  const std::size_t tilde = key.collection.find('~');
+  const std::string fused =
+      tilde == std::string::npos ? key.collection : key.collection.substr(0, tilde);
   MESHSEEK_ASSIGN_OR_RETURN(
       Statement select,
-      db_->Prepare("SELECT mesh FROM models WHERE collection = ? AND model_id = ?"));
-  select.Bind(1, key.collection).Bind(2, key.model_id);
+      db_->Prepare("SELECT mesh FROM models WHERE model_id = ?2 AND (collection = ?1 OR "
+                   "(?3 AND collection > ?4 || '~' AND collection < ?4 || '~~')) "
+                   "ORDER BY length(mesh) = 0 LIMIT 1"));
+  select.Bind(1, key.collection)
+      .Bind(2, key.model_id)
+      .Bind(3, int64_t{tilde != std::string::npos})
+      .Bind(4, fused);
   MESHSEEK_ASSIGN_OR_RETURN(const bool found, select.Step());
   if (!found) return std::nullopt;
   return select.ColumnBlob(0);

@@ -19,15 +19,6 @@ std::string PublicName(const std::string& collection) {
   return IsMemberCollection(collection) ? collection.substr(0, collection.find('~')) : collection;
 }
 
-absl::StatusOr<v1::LocalFeatures> ParseFeatures(const ExtractedModel& model) {
-  v1::LocalFeatures features;
-  if (!features.ParseFromString(model.features)) {
-    return absl::DataLossError(
-        absl::StrCat("model ", model.model_id, ": stored features do not parse"));
-  }
-  return features;
-}
-
 }  // namespace
 
 LiveIndex::LiveIndex(CoordinatorStore* store, Workers* workers)
@@ -88,27 +79,33 @@ absl::Status LiveIndex::ModelExtracted(const ModelKey& key,
   absl::StatusOr<CollectionPlan> plan = part_plan;
   if (name != key.collection) plan = LoadCollectionPlan(store_, name);
   if (!plan.ok()) return plan.status();
-  if (!plan->options.rescaled() || plan->codebook_id.empty()) return absl::OkStatus();
+  if (!plan->options.rescaled() || plan->codebook_id.empty()) {
+    // Indexed: its features are not read again before the next build.
+    return store_->DropFeatures({part.name}, part_plan.build(), key.model_id);
+  }
   return Join(*plan, RankedModel{key.model_id, ordinal, label});
 }
 
 absl::Status LiveIndex::Join(const CollectionPlan& plan, const RankedModel& model) {
   MESHSEEK_ASSIGN_OR_RETURN(std::shared_ptr<LiveRanking> live, RankingOf(plan));
   absl::MutexLock join(&live->join_mutex);
+  const std::string build = plan.build();
   {
     absl::ReaderMutexLock lock(&live->mutex);
-    if (live->ranking.node_of.contains(model.model_id)) return absl::OkStatus();
+    if (live->ranking.node_of.contains(model.model_id)) {
+      return store_->DropFeatures(plan.PartNames(), build, model.model_id);
+    }
   }
   // Every part's signature of the model, from its stored features, once
   // every part has indexed it with this build's codebook.
-  const std::string build = plan.build();
   std::vector<IndexSignature> signatures;
   for (const CollectionInfo& part : plan.parts) {
     const std::string codebook_id = absl::StrCat(part.name, "@", build);
     MESHSEEK_ASSIGN_OR_RETURN(const std::optional<ExtractedModel> stored,
                               store_->LoadExtracted({part.name, model.model_id}));
     if (!stored.has_value() || stored->indexed_codebook != codebook_id) return absl::OkStatus();
-    MESHSEEK_ASSIGN_OR_RETURN(const v1::LocalFeatures features, ParseFeatures(*stored));
+    MESHSEEK_ASSIGN_OR_RETURN(const v1::LocalFeatures features,
+                              workers_->FeaturesOf(store_, part, *stored));
     MESHSEEK_ASSIGN_OR_RETURN(IndexSignature signature,
                               workers_->Encode(part, codebook_id, features));
     signatures.push_back(std::move(signature));
@@ -126,8 +123,12 @@ absl::Status LiveIndex::Join(const CollectionPlan& plan, const RankedModel& mode
       const bool stored,
       store_->AddRankingJoin(plan.name, build, model.model_id, planned->Serialize()));
   if (!stored) return absl::OkStatus();  // a newer build ranks it
-  absl::MutexLock lock(&live->mutex);
-  return live->ranking.Apply(*planned);
+  {
+    absl::MutexLock lock(&live->mutex);
+    MESHSEEK_RETURN_IF_ERROR(live->ranking.Apply(*planned));
+  }
+  // Indexed and ranked: its features are not read again before the next build.
+  return store_->DropFeatures(plan.PartNames(), build, model.model_id);
 }
 
 absl::Status LiveIndex::CatchUp(const std::string& collection) {
@@ -139,7 +140,8 @@ absl::Status LiveIndex::CatchUp(const std::string& collection) {
     MESHSEEK_ASSIGN_OR_RETURN(const std::vector<ExtractedModel> behind,
                               store_->ExtractedModels(part.name, part.codebook_id));
     for (const ExtractedModel& m : behind) {
-      MESHSEEK_ASSIGN_OR_RETURN(const v1::LocalFeatures features, ParseFeatures(m));
+      MESHSEEK_ASSIGN_OR_RETURN(const v1::LocalFeatures features,
+                                workers_->FeaturesOf(store_, part, m));
       MESHSEEK_RETURN_IF_ERROR(Prefixed(IndexInPart(part, m.model_id, features, m.ordinal, m.label),
                                         absl::StrCat("model ", m.model_id, ": ")));
       ++indexed;
@@ -161,6 +163,7 @@ absl::Status LiveIndex::CatchUp(const std::string& collection) {
       ++joined;
     }
   }
+  MESHSEEK_RETURN_IF_ERROR(store_->DropFeatures(plan.PartNames(), plan.build()));
   if (indexed + joined > 0) {
     MESHSEEK_LOG(INFO) << "coordinator: " << collection << ": caught up with " << indexed
                        << " model copies to index and " << joined << " models to rank";

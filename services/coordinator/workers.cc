@@ -182,4 +182,25 @@ absl::Status Workers::AddToIndex(const std::string& collection,
   return index_->Add(request);
 }
 
+absl::StatusOr<v1::LocalFeatures> Workers::FeaturesOf(CoordinatorStore* store,
+                                                     const CollectionInfo& part,
+                                                     const ExtractedModel& model) {
+  v1::LocalFeatures features;
+  if (!model.features.empty()) {
+    if (!features.ParseFromString(model.features)) {
+      return absl::DataLossError(
+          absl::StrCat("model ", model.model_id, ": stored features do not parse"));
+    }
+    return features;
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(const std::optional<std::string> stored,
+                            store->ModelMesh({part.name, model.model_id}));
+  v1::Mesh mesh;
+  if (!stored.has_value() || !mesh.ParseFromString(*stored)) {
+    return absl::DataLossError(
+        absl::StrCat("model ", model.model_id, ": no stored mesh to extract its features from"));
+  }
+  return Extract(mesh, part, model.model_id);
+}
+
 }  // namespace meshseek

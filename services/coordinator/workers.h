@@ -95,6 +95,13 @@ class Workers {
                           const std::string& label,
                           const IndexSignature& signature);
 
+  /// An extracted model's features: as stored, or, once freed after
+  /// indexing (CoordinatorStore::DropFeatures), extracted again from its
+  /// stored mesh (the same features: extraction is deterministic).
+  absl::StatusOr<v1::LocalFeatures> FeaturesOf(CoordinatorStore* store,
+                                               const CollectionInfo& part,
+                                               const ExtractedModel& model);
+
   v1::Codebook::Stub* codebook() { return codebook_.get(); }
   IndexShards* index() { return index_.get(); }
   const rpc::RetryOptions& retry() const { return retry_; }
