@@ -15,7 +15,7 @@ echo "# bench/storage.sh $MANIFEST $METHOD: $(date -u '+%F %H:%M UTC'), $(nproc)
 echo "# build/cli/meshseek eval --manifest $MANIFEST --method $METHOD --data_dir <fresh> --out <dir>"
 /usr/bin/time -f "# eval: wall %e s, peak RSS %M KiB" \
   build/cli/meshseek eval --progress=false --manifest "$MANIFEST" --method "$METHOD" \
-  --data_dir "$WORK/data" --out "$WORK/eval" 2>&1 | grep -E "^# eval|first tier|FT" || true
+  --data_dir "$WORK/data" --out "$WORK/eval" 2>&1 | grep -E "^# eval|first tier|micro|time " || true
 # Let SQLite fold its write-ahead logs into the files before they are measured.
 python3 - "$WORK/data" <<'EOF'
 import os, sqlite3, sys

@@ -18,7 +18,10 @@ absl::StatusOr<std::unique_ptr<Database>> Database::Open(const std::string& path
   std::unique_ptr<Database> database(new Database(db, path));
   sqlite3_busy_timeout(db, 5000);
   if (absl::Status s = database->Execute(
-          "PRAGMA journal_mode=WAL; PRAGMA synchronous=NORMAL; PRAGMA foreign_keys=ON;");
+          // auto_vacuum first: a new file takes it only before the WAL
+          // header is written; an existing file keeps what it has.
+          "PRAGMA auto_vacuum=INCREMENTAL; PRAGMA journal_mode=WAL; PRAGMA synchronous=NORMAL; "
+          "PRAGMA foreign_keys=ON;");
       !s.ok()) {
     return s;
   }

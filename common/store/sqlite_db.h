@@ -7,6 +7,11 @@
 // loss or kernel crash may lose the last transactions. That is the failure the
 // services promise to survive ("an acknowledged add survives kill -9").
 //
+// Space: a file created by this wrapper is in incremental auto_vacuum mode, so
+// `PRAGMA incremental_vacuum` gives freed pages back to the file system (the
+// coordinator does after freeing stored features); otherwise SQLite keeps
+// them for reuse and the file never shrinks.
+//
 // Not part of the algorithm core (common/ modules before pipeline never use
 // it). A Database is used by one thread at a time; services guard it with
 // their own mutex.

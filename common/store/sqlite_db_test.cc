@@ -1,6 +1,7 @@
 #include "common/store/sqlite_db.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "gtest/gtest.h"
@@ -41,6 +42,21 @@ TEST(DatabaseTest, StoresAndReadsBackTypedValuesAcrossReopen) {
   row = select->Step();
   ASSERT_TRUE(row.ok());
   EXPECT_FALSE(*row);
+}
+
+TEST(DatabaseTest, FreedPagesGoBackToTheFileSystem) {
+  const std::string path = TempPath("vacuum.db");
+  auto db = Database::Open(path);
+  ASSERT_TRUE(db.ok()) << db.status();
+  ASSERT_TRUE((*db)->Execute("CREATE TABLE t (x BLOB); INSERT INTO t VALUES (zeroblob(8000000)); "
+                             "PRAGMA wal_checkpoint(TRUNCATE)")
+                  .ok());
+  const auto grown = std::filesystem::file_size(path);
+  EXPECT_GT(grown, 8000000u);
+  ASSERT_TRUE((*db)->Execute("UPDATE t SET x = NULL; PRAGMA incremental_vacuum; "
+                             "PRAGMA wal_checkpoint(TRUNCATE)")
+                  .ok());
+  EXPECT_LT(std::filesystem::file_size(path), grown / 10);
 }
 
 TEST(DatabaseTest, ErrorsNameTheDatabaseAndTheStatement) {

@@ -296,7 +296,10 @@ absl::Status CoordinatorStore::DropFeatures(const std::vector<std::string>& coll
   for (std::size_t i = 0; i < collections.size(); ++i) {
     drop.Bind(static_cast<int>(i) + 3, collections[i]);
   }
-  return drop.Run();
+  MESHSEEK_RETURN_IF_ERROR(drop.Run());
+  // The freed pages back to the file system (a no-op in files of releases
+  // before auto_vacuum, which reuse them).
+  return db_->Execute("PRAGMA incremental_vacuum");
 }
 
 absl::StatusOr<std::optional<ExtractedModel>> CoordinatorStore::LoadExtracted(
