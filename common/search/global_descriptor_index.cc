@@ -81,6 +81,20 @@ absl::StatusOr<std::vector<KlNeighbor>> GlobalDescriptorIndex::Distances(
   return out;
 }
 
+absl::StatusOr<std::vector<KlNeighbor>> GlobalDescriptorIndex::DistancesTo(
+    absl::Span<const uint8_t> query, absl::Span<const uint32_t> docs) const {
+  if (absl::Status s = CheckSize(query.size()); !s.ok()) return s;
+  std::vector<KlNeighbor> out(docs.size());
+  for (std::size_t i = 0; i < docs.size(); ++i) {
+    const auto it = slot_.find(docs[i]);
+    if (it == slot_.end()) {
+      return absl::NotFoundError(absl::StrCat("distances: model ", docs[i], " is not stored"));
+    }
+    out[i] = {docs[i], distance_(query.data(), data_.data() + it->second * dimension_, dimension_)};
+  }
+  return out;
+}
+
 absl::StatusOr<std::vector<KlNeighbor>> GlobalDescriptorIndex::Search(
     absl::Span<const uint8_t> query, std::size_t k, int num_threads) const {
   absl::StatusOr<std::vector<KlNeighbor>> all = Distances(query, num_threads);

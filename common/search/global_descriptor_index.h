@@ -41,6 +41,10 @@ class GlobalDescriptorIndex {
   /// The query's distance to every doc, in no particular order.
   absl::StatusOr<std::vector<KlNeighbor>> Distances(absl::Span<const uint8_t> query,
                                                     int num_threads) const;
+  /// The query's distance to each of `docs`, in that order (the values
+  /// Distances gives them). NotFound for a doc that is not stored.
+  absl::StatusOr<std::vector<KlNeighbor>> DistancesTo(absl::Span<const uint8_t> query,
+                                                      absl::Span<const uint32_t> docs) const;
   /// The k nearest docs (ties by doc), and every doc tied with the k-th.
   absl::StatusOr<std::vector<KlNeighbor>> Search(absl::Span<const uint8_t> query,
                                                  std::size_t k,

@@ -56,6 +56,15 @@ TEST(GlobalDescriptorIndexTest, SearchIsTheExhaustiveRankingAndSurvivesRemovals)
     EXPECT_EQ((*found)[r].doc, expected[r].second);
     EXPECT_EQ((*found)[r].distance, expected[r].first);
   }
+  const std::vector<uint32_t> some = {20, 11, 0};
+  const auto to_some = index->DistancesTo(query, some);
+  ASSERT_TRUE(to_some.ok());
+  for (std::size_t i = 0; i < some.size(); ++i) {
+    EXPECT_EQ((*to_some)[i].doc, some[i]);
+    EXPECT_EQ((*to_some)[i].distance, LfdDistance(query.data(), data[some[i]].data()));
+  }
+  EXPECT_EQ(index->DistancesTo(query, std::vector<uint32_t>{3}).status().code(),
+            absl::StatusCode::kNotFound);
   std::size_t visited = 0;
   index->ForEach([&](uint32_t doc, absl::Span<const uint8_t> bytes) {
     ++visited;

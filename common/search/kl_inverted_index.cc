@@ -411,9 +411,20 @@ std::vector<KlNeighbor> KlInvertedIndex::RerankCandidates(const PreparedQuery& q
                      nearer);
     proposals.resize(candidates);
   }
-  // 2. Their exact distances from the forward index: the query as dense
-  //    arrays, zero off its words, so that each candidate's words are summed
-  //    in word order with zero terms elsewhere, the same doubles as the scan.
+  // 2. Their exact distances from the forward index.
+  std::vector<Location> at(proposals.size());
+  for (std::size_t c = 0; c < proposals.size(); ++c) {
+    at[c] = {proposals[c].segment, proposals[c].slot};
+  }
+  return ForwardDistances(q, at, num_threads);
+}
+
+std::vector<KlNeighbor> KlInvertedIndex::ForwardDistances(const PreparedQuery& q,
+                                                          const std::vector<Location>& at,
+                                                          int num_threads) const {
+  // The query as dense arrays, zero off its words, so that each model's
+  // words are summed in word order with zero terms elsewhere: the same
+  // doubles as the scan.
   thread_local std::vector<double> dense_x, dense_g;
   dense_x.assign(vocabulary_, 0.0);
   dense_g.assign(vocabulary_, 0.0);
@@ -421,29 +432,47 @@ std::vector<KlNeighbor> KlInvertedIndex::RerankCandidates(const PreparedQuery& q
     dense_x[q.words[i]] = q.weights[i];
     dense_g[q.words[i]] = q.g[i];
   }
-  // Read-only from here: the re-ranking threads share them.
+  // Read-only from here: the threads share them.
   const double* x = dense_x.data();
   const double* gx = dense_g.data();
-  std::vector<KlNeighbor> out(proposals.size());
+  std::vector<KlNeighbor> out(at.size());
   constexpr std::size_t kPerTask = 256;
-  ParallelFor((proposals.size() + kPerTask - 1) / kPerTask, num_threads, [&](std::size_t task) {
-    const std::size_t end = std::min(proposals.size(), (task + 1) * kPerTask);
+  ParallelFor((at.size() + kPerTask - 1) / kPerTask, num_threads, [&](std::size_t task) {
+    const std::size_t end = std::min(at.size(), (task + 1) * kPerTask);
     for (std::size_t c = task * kPerTask; c < end; ++c) {
-      const Proposal& p = proposals[c];
-      const Segment& seg = *segments_[p.segment];
+      const Segment& seg = *segments_[at[c].segment];
+      const uint16_t slot = at[c].slot;
+      if (q.empty() || seg.empty[slot]) {  // the scan's rule for models without words
+        out[c] = {seg.docs[slot], kInfinity};
+        continue;
+      }
       double query_side = 0.0, model_side = 0.0;
-      const std::size_t first = p.slot == 0 ? 0 : seg.forward_end[p.slot - 1];
-      for (std::size_t i = first; i < seg.forward_end[p.slot]; ++i) {
+      const std::size_t first = slot == 0 ? 0 : seg.forward_end[slot - 1];
+      for (std::size_t i = first; i < seg.forward_end[slot]; ++i) {
         const uint16_t word = seg.forward_words[i];
         const Float2 value = seg.values[seg.forward_values[i]];
         query_side += x[word] * static_cast<double>(value[0]);
         model_side += static_cast<double>(value[1]) * gx[word];
       }
-      const double distance = Combine(q, seg, p.slot, query_side, model_side);
-      out[c] = {seg.docs[p.slot], distance > 0.0 ? static_cast<float>(distance) : 0.0f};
+      const double distance = Combine(q, seg, slot, query_side, model_side);
+      out[c] = {seg.docs[slot], distance > 0.0 ? static_cast<float>(distance) : 0.0f};
     }
   });
   return out;
+}
+
+absl::StatusOr<std::vector<KlNeighbor>> KlInvertedIndex::DistancesTo(
+    const SparseHistogram& query, absl::Span<const uint32_t> docs, int num_threads) const {
+  MESHSEEK_ASSIGN_OR_RETURN(const PreparedQuery q, Prepare(query, "query"));
+  std::vector<Location> at(docs.size());
+  for (std::size_t i = 0; i < docs.size(); ++i) {
+    const auto it = locations_.find(docs[i]);
+    if (it == locations_.end()) {
+      return absl::NotFoundError(absl::StrCat("distances: model ", docs[i], " is not stored"));
+    }
+    at[i] = it->second;
+  }
+  return ForwardDistances(q, at, num_threads);
 }
 
 absl::StatusOr<std::vector<KlNeighbor>> KlInvertedIndex::Search(const SparseHistogram& query,

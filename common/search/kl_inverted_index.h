@@ -104,6 +104,7 @@
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/types/span.h"
 #include "common/bof/kl_divergence.h"
 #include "common/search/histogram_embedding.h"
 #include "common/search/sparse_histogram.h"
@@ -161,6 +162,15 @@ class KlInvertedIndex {
   absl::StatusOr<std::vector<KlNeighbor>> Distances(const SparseHistogram& query,
                                                     int num_threads) const;
 
+  /// Distances from `query` to each of `docs`, in that order, bit for bit the
+  /// values Distances gives them, from the forward index: O(words of those
+  /// models), not a scan of the postings (what a fused query's candidates
+  /// need, docs/design.md "Fused candidates"). NotFound for a doc that is not
+  /// stored; InvalidArgument for an invalid query.
+  absl::StatusOr<std::vector<KlNeighbor>> DistancesTo(const SparseHistogram& query,
+                                                      absl::Span<const uint32_t> docs,
+                                                      int num_threads) const;
+
   /// The `k` nearest models to `query` by (distance, doc), followed by any
   /// others at the k-th distance (so a caller may break ties its own way).
   /// `candidates` = 0: exact, every model scanned. Otherwise the k nearest
@@ -205,6 +215,10 @@ class KlInvertedIndex {
   // Exact distances to the `candidates` models the embedding puts nearest.
   std::vector<KlNeighbor> RerankCandidates(const PreparedQuery& query,
                                            std::size_t candidates,
+                                           int num_threads) const;
+  // Exact distances to the models at `at`, from the forward index.
+  std::vector<KlNeighbor> ForwardDistances(const PreparedQuery& query,
+                                           const std::vector<Location>& at,
                                            int num_threads) const;
   // D from the common sums (the formula above).
   static double Combine(const PreparedQuery& query,

@@ -316,6 +316,36 @@ TEST(KlInvertedIndexTest, ModelsWithoutFeaturesAreInfinitelyFar) {
                                               (*matrix)[2], kInf, 0.0f));
 }
 
+TEST(KlInvertedIndexTest, DistancesToAFewModelsAreTheScansBitForBit) {
+  // Among them an empty model and a removed one.
+  auto dense = CountHistograms(300, 120, 2000, 21);
+  KlInvertedIndex index = MakeIndex(dense);
+  SparseHistogram empty;
+  empty.vocabulary = 120;
+  ASSERT_TRUE(index.Upsert(400, empty).ok());
+  ASSERT_TRUE(index.Remove(17));
+  for (uint32_t query : {0u, 150u, 299u}) {
+    const SparseHistogram q = SparseFromDense(dense[query]);
+    const std::vector<float> scan = ByDoc(*index.Distances(q, 2), 401);
+    const std::vector<uint32_t> docs = {299, 3, 400, query, 250, 3};
+    const auto some = index.DistancesTo(q, docs, 2);
+    ASSERT_TRUE(some.ok()) << some.status();
+    ASSERT_EQ(some->size(), docs.size());
+    for (std::size_t i = 0; i < docs.size(); ++i) {
+      EXPECT_EQ((*some)[i].doc, docs[i]);
+      EXPECT_EQ((*some)[i].distance, scan[docs[i]]) << docs[i];
+    }
+    EXPECT_EQ((*some)[2].distance, kInf);
+  }
+  const auto from_empty = index.DistancesTo(empty, std::vector<uint32_t>{0, 400}, 1);
+  ASSERT_TRUE(from_empty.ok());
+  EXPECT_EQ((*from_empty)[0].distance, kInf);
+  EXPECT_EQ((*from_empty)[1].distance, kInf);
+  const auto removed = index.DistancesTo(SparseFromDense(dense[0]), std::vector<uint32_t>{17}, 1);
+  EXPECT_EQ(removed.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(removed.status().message(), HasSubstr("model 17"));
+}
+
 TEST(KlInvertedIndexTest, RejectsBadInputAndLeavesTheIndexUnchanged) {
   EXPECT_FALSE(KlInvertedIndex::Create(0).ok());
   KlDivergenceOptions bad;

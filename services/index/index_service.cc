@@ -346,12 +346,29 @@ std::vector<uint32_t> IndexService::DocsInOrder(const Collection& collection) {
   std::vector<uint32_t> docs;
   docs.reserve(collection.models.size());
   for (const auto& [doc, model] : collection.models) docs.push_back(doc);
-  std::sort(docs.begin(), docs.end(), [&](uint32_t a, uint32_t b) {
+  SortDocs(collection, &docs);
+  return docs;
+}
+
+std::vector<uint32_t> IndexService::DocsInOrder(
+    const Collection& collection, const google::protobuf::RepeatedPtrField<std::string>& model_ids) {
+  std::vector<uint32_t> docs;
+  for (const std::string& id : model_ids) {
+    const auto it = collection.docs.find(id);
+    if (it != collection.docs.end()) docs.push_back(it->second);
+  }
+  std::sort(docs.begin(), docs.end());
+  docs.erase(std::unique(docs.begin(), docs.end()), docs.end());
+  SortDocs(collection, &docs);
+  return docs;
+}
+
+void IndexService::SortDocs(const Collection& collection, std::vector<uint32_t>* docs) {
+  std::sort(docs->begin(), docs->end(), [&](uint32_t a, uint32_t b) {
     const Model& x = collection.models.at(a);
     const Model& y = collection.models.at(b);
     return std::tie(x.ordinal, x.model_id) < std::tie(y.ordinal, y.model_id);
   });
-  return docs;
 }
 
 grpc::Status IndexService::Search(grpc::ServerContext*,
@@ -463,6 +480,11 @@ grpc::Status IndexService::Distances(grpc::ServerContext*,
   if (request->queries_size() > 0 && request->global_queries_size() > 0) {
     return InvalidArgument("distances: both histogram and descriptor queries");
   }
+  if (request->model_ids_size() > kMaxDistanceModels) {
+    return InvalidArgument(absl::StrCat("distances: ", request->model_ids_size(),
+                                        " model ids, at most ", kMaxDistanceModels,
+                                        " per request"));
+  }
   std::vector<Signature> queries;
   for (int q = 0; q < request->queries_size(); ++q) {
     absl::StatusOr<Signature> query =
@@ -490,7 +512,11 @@ grpc::Status IndexService::Distances(grpc::ServerContext*,
       return InvalidArgument(absl::StrCat("distances: query ", q, ": ", fits.message()));
     }
   }
-  const std::vector<uint32_t> docs = DocsInOrder(collection);
+  // Every model, or those asked for (exact distances from the forward
+  // index, not a scan: what a fused query's candidates need).
+  const bool subset = request->model_ids_size() > 0;
+  const std::vector<uint32_t> docs =
+      subset ? DocsInOrder(collection, request->model_ids()) : DocsInOrder(collection);
   absl::flat_hash_map<uint32_t, std::size_t> column;
   for (std::size_t i = 0; i < docs.size(); ++i) {
     column[docs[i]] = i;
@@ -503,10 +529,15 @@ grpc::Status IndexService::Distances(grpc::ServerContext*,
   float* out = response->mutable_distances()->mutable_data();
   std::vector<absl::Status> errors(queries.size());
   ParallelFor(queries.size(), options_.num_threads, [&](std::size_t q) {
-    absl::StatusOr<std::vector<KlNeighbor>> row =
-        queries[q].descriptor.has_value()
-            ? collection.global->Distances(AsBytes(queries[q].descriptor->data()), 1)
-            : collection.engine->Distances(queries[q].histogram, 1);
+    absl::StatusOr<std::vector<KlNeighbor>> row;
+    if (queries[q].descriptor.has_value()) {
+      const auto bytes = AsBytes(queries[q].descriptor->data());
+      row = subset ? collection.global->DistancesTo(bytes, docs)
+                   : collection.global->Distances(bytes, 1);
+    } else {
+      row = subset ? collection.engine->DistancesTo(queries[q].histogram, docs, 1)
+                   : collection.engine->Distances(queries[q].histogram, 1);
+    }
     if (!row.ok()) {
       errors[q] = row.status();
       return;

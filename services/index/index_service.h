@@ -50,6 +50,8 @@ class IndexService final : public v1::Index::Service {
  public:
   /// Most query histograms in one Distances request.
   static constexpr int kMaxDistanceQueries = 4096;
+  /// Most model ids one Distances request may restrict itself to.
+  static constexpr int kMaxDistanceModels = 65536;
 
   static absl::StatusOr<std::unique_ptr<IndexService>> Create(const IndexServiceOptions& options);
 
@@ -127,6 +129,12 @@ class IndexService final : public v1::Index::Service {
       ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   // Docs in (ordinal, model id) order.
   static std::vector<uint32_t> DocsInOrder(const Collection& collection);
+  // The docs of those of `model_ids` the collection holds, each once, in the
+  // same order.
+  static std::vector<uint32_t> DocsInOrder(const Collection& collection,
+                                           const google::protobuf::RepeatedPtrField<std::string>& model_ids);
+  // Sorts docs by (ordinal, model id).
+  static void SortDocs(const Collection& collection, std::vector<uint32_t>* docs);
 
   const IndexServiceOptions options_;
   // Serialises writers: the database write and the in-memory update of one
