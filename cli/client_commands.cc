@@ -37,7 +37,8 @@ ABSL_FLAG(std::string, folder, "", "ingest: every mesh file in this folder (id =
 ABSL_FLAG(int, top_k, 10, "query: results to print");
 ABSL_FLAG(int, candidates, 0,
           "query: 0 searches exactly; N re-ranks the N candidates an embedding proposes "
-          "(faster on large collections, may miss a neighbour)");
+          "(faster on large collections, may miss a neighbour); on a fused collection each "
+          "method proposes N and their union is fused and re-ranked");
 ABSL_FLAG(std::string, job, "", "status: a job id to follow until it ends");
 ABSL_FLAG(int,
           metrics_port,

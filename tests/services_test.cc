@@ -94,6 +94,10 @@ class Server {
       _exit(127);
     }
   }
+  // Flags of the next Start.
+  void AddArgs(const std::vector<std::string>& args) {
+    args_.insert(args_.end(), args.begin(), args.end());
+  }
   void Kill(int signal) {
     if (pid_ <= 0) return;
     ::kill(pid_, signal);
@@ -644,6 +648,20 @@ TEST_F(ServicesTest, AGlobalDescriptorCollectionSurvivesKillsAndEqualsInProcess)
     std::sort(row.begin(), row.end());
     return row[1];
   }());
+  // Candidates cannot act on one global method: an error, never ignored.
+  {
+    grpc::ClientContext context;
+    rpc::SetDeadline(&context, absl::Seconds(60));
+    v1::QueryRequest request;
+    request.set_collection("lfd");
+    request.set_top_k(3);
+    request.set_candidates(10);
+    request.set_model_id((*models_)[0].id);
+    v1::QueryResponse ignored;
+    const grpc::Status refused = stub->Query(&context, request, &ignored);
+    EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(refused.error_message(), HasSubstr("candidates=10 does not apply"));
+  }
 }
 
 // A fused, re-ranked collection (LSF + LFD, small settings): each model
@@ -765,19 +783,44 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
     ASSERT_GT(found.results_size(), 0);
     EXPECT_EQ(found.results(0).model_id(), (*models_)[n].id);
   }
-  // Candidates cannot act on a fused collection: an error, never ignored.
+  // Fused candidates (two index shards): each member proposes, the union is
+  // fused and re-ranked. Candidates covering the collection give the exact
+  // answer bit for bit; a few still find the model itself first.
   {
+    const auto query = [&](uint32_t candidates, uint32_t top_k) {
+      grpc::ClientContext context;
+      rpc::SetDeadline(&context, absl::Seconds(60));
+      v1::QueryRequest request;
+      request.set_collection("fused");
+      request.set_top_k(top_k);
+      request.set_candidates(candidates);
+      request.set_model_id((*models_)[2].id);
+      v1::QueryResponse response;
+      const grpc::Status status = stub->Query(&context, request, &response);
+      EXPECT_TRUE(status.ok()) << status.error_message();
+      return response;
+    };
+    const v1::QueryResponse exact = query(0, 8);
+    const v1::QueryResponse covering = query(n + 1, 8);
+    ASSERT_EQ(covering.results_size(), exact.results_size());
+    for (int r = 0; r < exact.results_size(); ++r) {
+      EXPECT_EQ(covering.results(r).model_id(), exact.results(r).model_id()) << r;
+      EXPECT_EQ(covering.results(r).distance(), exact.results(r).distance()) << r;
+    }
+    const v1::QueryResponse few = query(2, 3);
+    ASSERT_GE(few.results_size(), 1);
+    EXPECT_EQ(few.results(0).model_id(), (*models_)[2].id);
+    EXPECT_LE(few.results_size(), 3);
     grpc::ClientContext context;
-    rpc::SetDeadline(&context, absl::Seconds(60));
     v1::QueryRequest request;
     request.set_collection("fused");
     request.set_top_k(3);
-    request.set_candidates(10);
-    request.set_model_id((*models_)[0].id);
-    v1::QueryResponse ignored;
-    const grpc::Status refused = stub->Query(&context, request, &ignored);
+    request.set_candidates(8193);  // one past kMaxFusedCandidates
+    request.set_model_id((*models_)[2].id);
+    v1::QueryResponse unanswered;
+    const grpc::Status refused = stub->Query(&context, request, &unanswered);
     EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-    EXPECT_THAT(refused.error_message(), HasSubstr("candidates=10 does not apply"));
+    EXPECT_THAT(refused.error_message(), HasSubstr("at most 8192"));
   }
 
   // Bounded storage: each mesh once, and no features kept once a model is
@@ -793,8 +836,15 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
   EXPECT_EQ(stored("SUM(length(mesh) > 0)"), static_cast<int64_t>(n + 1));
   EXPECT_EQ(stored("COUNT(*)"), static_cast<int64_t>(2 * (n + 1)));
   // A rebuild (features extracted again, the live model trained on too)
-  // gives the in-process matrix of every model, bit for bit.
+  // gives the in-process matrix of every model, bit for bit; its graph made
+  // from candidates (the approximate graph of large collections), which give
+  // the exact one when they cover the collection.
   {
+    stack.coordinator().Kill(SIGKILL);
+    stack.coordinator().AddArgs(
+        {"--exact_graph_models=0", absl::StrCat("--graph_candidates=", n + 1)});
+    stack.coordinator().Start();
+    ASSERT_TRUE(stack.WaitServing());
     const std::vector<ManifestEntry> grown(models_->begin(), models_->begin() + n + 1);
     auto rebuilt = EvaluateCollection(grown, in_process);
     ASSERT_TRUE(rebuilt.ok()) << rebuilt.status();
@@ -825,6 +875,22 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
   status = Query(stub.get(), "fused", 4, 3, absl::Seconds(60), &response);
   ASSERT_TRUE(status.ok()) << status.error_message();
   for (const v1::ScoredModel& m : response.results()) EXPECT_NE(m.model_id(), (*models_)[4].id);
+
+  // A live ingest into the collection whose graph came from candidates
+  // joins it from candidates too: its own first result.
+  std::set<std::string> late;
+  ASSERT_EQ(Ingest(stub.get(), "fused", n + 1, n + 2, &late), 1u);
+  ASSERT_EQ(WaitJob(stub.get(), *late.begin()).state(), v1::JOB_STATE_SUCCEEDED);
+  const absl::Time extracted = absl::Now();
+  do {
+    response.Clear();
+    status = Query(stub.get(), "fused", n + 1, 3, absl::Seconds(60), &response);
+  } while (status.ok() && (response.results_size() == 0 ||
+                           response.results(0).model_id() != (*models_)[n + 1].id) &&
+           absl::Now() - extracted < absl::Seconds(2 * kSlowdown));
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GT(response.results_size(), 0);
+  EXPECT_EQ(response.results(0).model_id(), (*models_)[n + 1].id);
 }
 
 TEST_F(ServicesTest, TwoIndexShardsGiveTheResultsOfOneAndNeverAPartialAnswer) {

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 
+#include "absl/container/flat_hash_set.h"
 #include "absl/strings/str_cat.h"
 #include "common/base/byte_order.h"
 #include "common/base/hash.h"
@@ -75,6 +76,30 @@ void NeighborGraph::SetRow(uint32_t i, absl::Span<const float> row) {
   };
   std::partial_sort(all.begin(), all.begin() + k_, all.end(), before);
   std::copy(all.begin(), all.begin() + k_, lists_.begin() + static_cast<std::size_t>(i) * k_);
+}
+
+void NeighborGraph::SetSparseRow(uint32_t i, absl::Span<const GraphNeighbor> known) {
+  thread_local std::vector<GraphNeighbor> finite;
+  thread_local absl::flat_hash_set<uint32_t> listed;
+  finite.assign(1, GraphNeighbor{i, 0.0f});
+  for (const GraphNeighbor& nb : known) {
+    if (nb.node != i && std::isfinite(nb.distance)) finite.push_back(nb);
+  }
+  const auto before = [i](const GraphNeighbor& a, const GraphNeighbor& b) {
+    return NeighborBefore(i, a, b);
+  };
+  const std::size_t k = static_cast<std::size_t>(k_);
+  const std::size_t take = std::min(k, finite.size());
+  std::partial_sort(finite.begin(), finite.begin() + take, finite.end(), before);
+  GraphNeighbor* list = lists_.data() + static_cast<std::size_t>(i) * k;
+  std::copy(finite.begin(), finite.begin() + take, list);
+  // The rest at +inf, by node, as SetRow orders them.
+  listed.clear();
+  for (const GraphNeighbor& nb : finite) listed.insert(nb.node);
+  std::size_t at = take;
+  for (uint32_t j = 0; at < k && j < n_; ++j) {
+    if (!listed.contains(j)) list[at++] = GraphNeighbor{j, std::numeric_limits<float>::infinity()};
+  }
 }
 
 GraphJoin NeighborGraph::PlanJoin(absl::Span<const float> row, int k) const {

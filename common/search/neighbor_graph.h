@@ -72,6 +72,13 @@ class NeighborGraph {
   /// threads at once, each row by one.
   void SetRow(uint32_t i, absl::Span<const float> row);
 
+  /// Sets node i's list from its distances to some nodes only (`known`,
+  /// each node at most once, < n; an entry for i itself is ignored), every
+  /// other node at +inf: the list SetRow sets from that row, in
+  /// O(|known| log |known| + k) rather than O(n). What an approximate graph
+  /// is built from (docs/design.md "Approximate neighbour graph").
+  void SetSparseRow(uint32_t i, absl::Span<const GraphNeighbor> known);
+
   /// Live growth (docs/design.md, "Live ingest"). The join of a new node
   /// n = size() from its distances to nodes 0 .. n - 1 (`row`, n values, none
   /// NaN), in a graph whose lists were asked to hold `k` (as at Create): its

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 #include <random>
 
@@ -50,6 +51,33 @@ TEST(NeighborGraphTest, ShortCollectionsKeepEveryModelAndInfinityRanksLast) {
   EXPECT_EQ(graph->k(), 3);
   EXPECT_EQ(graph->Of(0)[1].node, 2u);
   EXPECT_EQ(graph->Of(0)[2], (GraphNeighbor{1, inf}));
+}
+
+TEST(NeighborGraphTest, SparseRowsAreTheRowsWithInfinityElsewhere) {
+  const float inf = std::numeric_limits<float>::infinity();
+  std::mt19937 rng(7);
+  for (const std::size_t n : {3, 12, 60}) {
+    for (const int k : {1, 5, 21}) {
+      auto sparse = NeighborGraph::Create(n, k);
+      auto dense = NeighborGraph::Create(n, k);
+      ASSERT_TRUE(sparse.ok() && dense.ok());
+      for (uint32_t i = 0; i < n; ++i) {
+        // A random subset, a tie, an infinite entry and the node itself.
+        std::vector<GraphNeighbor> known;
+        std::vector<float> row(n, inf);
+        for (uint32_t j = 0; j < n; ++j) {
+          if (rng() % 3 != 0) continue;
+          const float d = j % 7 == 3 ? inf : static_cast<float>(rng() % 5);
+          known.push_back({j, d});
+          row[j] = d;
+        }
+        std::shuffle(known.begin(), known.end(), rng);
+        sparse->SetSparseRow(i, known);
+        dense->SetRow(i, row);
+      }
+      EXPECT_TRUE(*sparse == *dense) << "n " << n << " k " << k;
+    }
+  }
 }
 
 TEST(NeighborGraphTest, SerializedGraphReadsBackAndDamageIsNamed) {

@@ -265,15 +265,19 @@ void BuildRunner::Run(const std::string& job_id, const std::string& collection) 
   const std::string codebook_id = absl::StrCat(collection, "@", job_id);
   if (plan->options.rescaled()) {
     const absl::Time start = absl::Now();
-    absl::StatusOr<RankingState> state = ComputeRankingState(workers_->index(), *plan);
+    absl::StatusOr<RankingState> state =
+        ComputeRankingState(workers_->index(), *plan, options_.ranking_graph);
     if (*stop_) return Done(collection);
     if (!state.ok()) return fail(Prefixed(state.status(), "ranking: "));
     if (absl::Status s = store_->SetRanking(collection, job_id, state->Serialize()); !s.ok()) {
       return fail(s);
     }
+    const bool approximate = plan->options.rerank.enabled() &&
+                             state->model_ids.size() > options_.ranking_graph.exact_graph_models;
     MESHSEEK_LOG(INFO) << "coordinator: " << job_id << ": ranking state of "
                        << state->model_ids.size() << " models in "
-                       << absl::FormatDuration(absl::Now() - start);
+                       << absl::FormatDuration(absl::Now() - start)
+                       << (approximate ? " (neighbour graph from candidates)" : "");
   }
   if (absl::Status s = store_->SetCodebook(collection, codebook_id); !s.ok()) return fail(s);
   absl::StatusOr<ModelCounts> counts = store_->CountModels(plan->PartNames(), job_id);

@@ -5,6 +5,8 @@
 
 #include <grpcpp/security/credentials.h>
 
+#include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -13,6 +15,26 @@
 #include "common/geometry/mesh_io.h"
 
 namespace meshseek {
+
+/// Largest `candidates` of a fused query (fused_candidates.h): six parts'
+/// unions stay within one Distances request's model ids (index.proto).
+inline constexpr uint32_t kMaxFusedCandidates = 8192;
+
+/// How a build's ranking step makes a re-ranked collection's neighbour graph
+/// (docs/design.md "Approximate neighbour graph").
+struct RankingGraphOptions {
+  /// All pairs up to this many models, candidates above. All pairs cost
+  /// O(N^2) distances; the default keeps the benchmarks' graphs (and so
+  /// their matrices) exact.
+  std::size_t exact_graph_models = 5000;
+  /// Candidates per method of each model's list in an approximate graph, in
+  /// [1, kMaxFusedCandidates]. Measured on the development sets:
+  /// bench/results/fused_candidates.txt.
+  uint32_t graph_candidates = 50;
+  /// Models whose lists are computed at once (each mostly waits on the
+  /// index), at least 1.
+  int threads = 4;
+};
 
 struct CoordinatorOptions {
   /// Folder of the database (coordinator.db); created if missing.
@@ -57,6 +79,9 @@ struct CoordinatorOptions {
   /// their certificates must carry when it is not the targets' host.
   std::shared_ptr<grpc::ChannelCredentials> service_credentials;
   std::string service_tls_name;
+
+  /// The ranking step of builds.
+  RankingGraphOptions ranking_graph;
 
   absl::Status Validate() const;
 };

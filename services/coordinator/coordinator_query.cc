@@ -2,7 +2,9 @@
 // collection of one method without re-ranking is ranked by the index alone
 // (top-k merged over the shards, its own distances); a fused or re-ranked one
 // by its build's Ranking (ranking.h), with the models that joined it live
-// (live_index.h), over every part's distances.
+// (live_index.h), over every part's distances, or with candidates over their
+// union of proposals (fused_candidates.h).
+#include <algorithm>
 #include <map>
 #include <optional>
 
@@ -12,6 +14,7 @@
 #include "common/rpc/convert.h"
 #include "common/rpc/status.h"
 #include "services/coordinator/coordinator_service.h"
+#include "services/coordinator/fused_candidates.h"
 
 namespace meshseek {
 namespace {
@@ -34,18 +37,21 @@ grpc::Status CoordinatorService::Query(grpc::ServerContext*,
     return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
                         absl::StrCat("collection '", request->collection(), "' is not built yet"));
   }
-  if (request->candidates() > 0) {
+  if (request->candidates() > 0 && !plan->options.rescaled() &&
+      FeatureMethodInfoOf(plan->parts.front().options.extractor.method).kind ==
+          DescriptorKind::kGlobal) {
     // Never ignored: a flag that cannot act is the caller's mistake.
-    const bool global = FeatureMethodInfoOf(plan->parts.front().options.extractor.method).kind ==
-                        DescriptorKind::kGlobal;
-    if (plan->options.rescaled() || global) {
-      return grpc::Status(
-          grpc::StatusCode::INVALID_ARGUMENT,
-          absl::StrCat("query: candidates=", request->candidates(), " does not apply to collection '",
-                       request->collection(), "' (",
-                       plan->options.rescaled() ? "fused or re-ranked" : "a global descriptor",
-                       ", ranked exactly); ask with candidates=0"));
-    }
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrCat("query: candidates=", request->candidates(),
+                                     " does not apply to collection '", request->collection(),
+                                     "' (a global descriptor, ranked exactly); ask with "
+                                     "candidates=0"));
+  }
+  if (plan->options.rescaled() && request->candidates() > kMaxFusedCandidates) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrCat("query: candidates=", request->candidates(),
+                                     " on fused or re-ranked collection '", request->collection(),
+                                     "'; at most ", kMaxFusedCandidates));
   }
   v1::Mesh arrays;
   if (!request->model_id().empty()) {
@@ -125,8 +131,13 @@ grpc::Status CoordinatorService::Query(grpc::ServerContext*,
   if (!ranking.ok()) return rpc::ToGrpcStatus(ranking.status());
   std::vector<const IndexSignature*> query(parts);
   for (std::size_t p = 0; p < parts; ++p) query[p] = &*signatures[p];
+  // With candidates, to the union of the parts' proposals only
+  // (fused_candidates.h).
   absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> distances =
-      PartDistances(workers_.index(), *plan, query);
+      request->candidates() > 0
+          ? CandidatePartDistances(workers_.index(), *plan, query,
+                                   std::max(request->candidates(), request->top_k()))
+          : PartDistances(workers_.index(), *plan, query);
   if (!distances.ok()) return rpc::ToGrpcStatus(distances.status());
   absl::StatusOr<std::vector<v1::ScoredModel>> found;
   {

@@ -156,40 +156,35 @@ absl::StatusOr<std::vector<IndexShards::Scored>> IndexShards::QueryDistances(
   return all;
 }
 
-absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
-                                             const std::function<absl::Status(const Row&)>& fn,
-                                             const std::vector<std::size_t>* only_rows) {
-  // 1. Every model of every part, from every shard; the first part's in
-  //    (ordinal, id) order gives the rows and columns, the others must hold
-  //    the same models.
+absl::StatusOr<IndexShards::PartModels> IndexShards::ExportParts(const std::vector<Part>& parts) {
+  // Every model of every part, from every shard; the first part's in
+  // (ordinal, id) order gives the rows, the others must hold the same models.
   const std::size_t p_count = parts.size();
-  std::vector<std::vector<v1::IndexedModel>> models(p_count);
+  PartModels out;
+  out.models.resize(p_count);
   for (std::size_t p = 0; p < p_count; ++p) {
     for (std::size_t s = 0; s < shards_.size(); ++s) {
       MESHSEEK_ASSIGN_OR_RETURN(std::vector<v1::IndexedModel> part, Export(s, parts[p].collection));
-      for (v1::IndexedModel& m : part) models[p].push_back(std::move(m));
+      for (v1::IndexedModel& m : part) out.models[p].push_back(std::move(m));
     }
-    if (models[p].empty()) {
+    if (out.models[p].empty()) {
       return absl::NotFoundError(
           absl::StrCat("index has no models in collection '", parts[p].collection, "'"));
     }
   }
-  std::sort(models[0].begin(), models[0].end(), Before);
-  const std::size_t n = models[0].size();
-  absl::flat_hash_map<std::string, std::size_t> column;
-  for (std::size_t i = 0; i < n; ++i) column[models[0][i].model_id()] = i;
-  // entry[p][i]: part p's entry of the model of row i.
-  std::vector<std::vector<const v1::IndexedModel*>> entry(p_count,
-                                                          std::vector<const v1::IndexedModel*>(n));
+  std::sort(out.models[0].begin(), out.models[0].end(), Before);
+  const std::size_t n = out.models[0].size();
+  for (std::size_t i = 0; i < n; ++i) out.row_of[out.models[0][i].model_id()] = i;
+  out.entry.assign(p_count, std::vector<const v1::IndexedModel*>(n));
   for (std::size_t p = 0; p < p_count; ++p) {
     std::size_t found = 0;
-    for (const v1::IndexedModel& m : models[p]) {
-      auto it = column.find(m.model_id());
-      if (it == column.end()) continue;
-      entry[p][it->second] = &m;
+    for (const v1::IndexedModel& m : out.models[p]) {
+      auto it = out.row_of.find(m.model_id());
+      if (it == out.row_of.end()) continue;
+      out.entry[p][it->second] = &m;
       ++found;
     }
-    if (found != n || models[p].size() != n) {
+    if (found != n || out.models[p].size() != n) {
       return absl::FailedPreconditionError(absl::StrCat("collections '",
                                                         parts[0].collection,
                                                         "' and '",
@@ -197,12 +192,25 @@ absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
                                                         "' hold ",
                                                         n,
                                                         " and ",
-                                                        models[p].size(),
+                                                        out.models[p].size(),
                                                         " models, ",
                                                         found,
                                                         " in common; build again"));
     }
   }
+  return out;
+}
+
+absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
+                                             const std::function<absl::Status(const Row&)>& fn,
+                                             const std::vector<std::size_t>* only_rows) {
+  // 1. Every model of every part, in row order.
+  const std::size_t p_count = parts.size();
+  MESHSEEK_ASSIGN_OR_RETURN(const PartModels exported, ExportParts(parts));
+  const std::vector<std::vector<v1::IndexedModel>>& models = exported.models;
+  const std::vector<std::vector<const v1::IndexedModel*>>& entry = exported.entry;
+  const absl::flat_hash_map<std::string, std::size_t>& column = exported.row_of;
+  const std::size_t n = exported.size();
 
   // 2. Blocks of rows: each shard gives the distances from the block's
   //    signatures to its own models, placed into their columns.

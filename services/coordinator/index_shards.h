@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "absl/types/span.h"
@@ -73,6 +74,19 @@ class IndexShards {
     std::string collection;
     double kl_epsilon = 0;
   };
+  /// Every model of some parts (one collection, or a fused collection's
+  /// members) as the index holds it: `models[0]` in (ordinal, id) order gives
+  /// the rows, and entry[p][i] is part p's entry of row i's model.
+  struct PartModels {
+    std::vector<std::vector<v1::IndexedModel>> models;  // per part, as exported
+    std::vector<std::vector<const v1::IndexedModel*>> entry;
+    absl::flat_hash_map<std::string, std::size_t> row_of;  // model id -> row
+    std::size_t size() const { return models.empty() ? 0 : models[0].size(); }
+  };
+  /// NOT_FOUND when no shard has a part's collection; FAILED_PRECONDITION
+  /// when the parts hold different models.
+  absl::StatusOr<PartModels> ExportParts(const std::vector<Part>& parts);
+
   /// One row of the all-pairs matrices of the parts.
   struct Row {
     const v1::IndexedModel* model;  // the first part's entry

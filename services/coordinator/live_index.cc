@@ -5,6 +5,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/base/logging.h"
 #include "common/base/status_macros.h"
+#include "services/coordinator/fused_candidates.h"
 
 namespace meshseek {
 namespace {
@@ -112,7 +113,19 @@ absl::Status LiveIndex::Join(const CollectionPlan& plan, const RankedModel& mode
   }
   std::vector<const IndexSignature*> query;
   for (const IndexSignature& s : signatures) query.push_back(&s);
-  MESHSEEK_ASSIGN_OR_RETURN(const auto distances, PartDistances(workers_->index(), plan, query));
+  // A collection past the exact graph's size joins from candidates, as its
+  // graph was built (fused_candidates.h): O(candidates), not O(n).
+  std::size_t nodes = 0;
+  {
+    absl::ReaderMutexLock lock(&live->mutex);
+    nodes = live->ranking.state.model_ids.size();
+  }
+  const RankingGraphOptions& graph = workers_->options().ranking_graph;
+  MESHSEEK_ASSIGN_OR_RETURN(
+      const auto distances,
+      nodes > graph.exact_graph_models
+          ? CandidatePartDistances(workers_->index(), plan, query, graph.graph_candidates)
+          : PartDistances(workers_->index(), plan, query));
   absl::StatusOr<RankingJoin> planned = absl::UnknownError("");
   {
     absl::ReaderMutexLock lock(&live->mutex);

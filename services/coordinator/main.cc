@@ -2,7 +2,10 @@
 // query, evaluation), orchestrating the worker and state services. Flags:
 // --data_dir, the four service targets, the work limits, --token_file (bearer
 // token of the public API), the TLS flags of the channels to the services
-// (--service_tls_*), and the server flags (common/rpc/server_main.h).
+// (--service_tls_*), the ranking graph (--exact_graph_models,
+// --graph_candidates), and the server flags (common/rpc/server_main.h).
+#include <algorithm>
+
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
@@ -38,6 +41,12 @@ ABSL_FLAG(absl::Duration, retry_backoff, kDefaults.retry_backoff,
 ABSL_FLAG(absl::Duration, max_retry_backoff, kDefaults.max_retry_backoff,
           "longest wait between a model's extraction attempts");
 
+ABSL_FLAG(int64_t, exact_graph_models,
+          static_cast<int64_t>(kDefaults.ranking_graph.exact_graph_models),
+          "a re-ranked collection's neighbour graph from all pairs up to this many models, from "
+          "candidates above");
+ABSL_FLAG(uint32_t, graph_candidates, kDefaults.ranking_graph.graph_candidates,
+          "candidates per method of each model's list in an approximate neighbour graph");
 ABSL_FLAG(std::string, token_file, "",
           "file holding the bearer token every call but grpc.health.v1 must carry "
           "(UNAUTHENTICATED otherwise); needs --tls_cert/--tls_key");
@@ -68,6 +77,9 @@ int main(int argc, char** argv) {
   options.model_attempts = absl::GetFlag(FLAGS_model_attempts);
   options.retry_backoff = absl::GetFlag(FLAGS_retry_backoff);
   options.max_retry_backoff = absl::GetFlag(FLAGS_max_retry_backoff);
+  options.ranking_graph.exact_graph_models =
+      static_cast<std::size_t>(std::max<int64_t>(0, absl::GetFlag(FLAGS_exact_graph_models)));
+  options.ranking_graph.graph_candidates = absl::GetFlag(FLAGS_graph_candidates);
   auto limits = meshseek::rpc::MeshLimitsFromFlags();
   if (!limits.ok()) return meshseek::rpc::ExitWithError("coordinator", limits.status());
   options.mesh_limits = *limits;

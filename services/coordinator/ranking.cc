@@ -13,6 +13,7 @@
 #include "common/base/status_macros.h"
 #include "common/search/fusion.h"
 #include "common/search/rerank.h"
+#include "services/coordinator/fused_candidates.h"
 
 namespace meshseek {
 namespace {
@@ -337,37 +338,6 @@ absl::StatusOr<std::vector<v1::ScoredModel>> Ranking::Query(
   return results;
 }
 
-absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> PartDistances(
-    IndexShards* index,
-    const CollectionPlan& plan,
-    const std::vector<const IndexSignature*>& signatures) {
-  const std::size_t parts = plan.parts.size();
-  if (signatures.size() != parts) {
-    return absl::InternalError(absl::StrCat(signatures.size(), " signatures for ", parts, " parts"));
-  }
-  std::vector<std::vector<IndexShards::Scored>> distances(parts);
-  std::vector<absl::Status> errors(parts);
-  ParallelFor(parts, static_cast<int>(parts), [&](std::size_t p) {
-    const CollectionInfo& part = plan.parts[p];
-    v1::DistancesRequest ask;
-    ask.set_collection(part.name);
-    ask.set_kl_epsilon(part.options.kl.epsilon);
-    if (signatures[p]->descriptor.has_value()) {
-      *ask.add_global_queries() = *signatures[p]->descriptor;
-    } else {
-      *ask.add_queries() = signatures[p]->histogram;
-    }
-    absl::StatusOr<std::vector<IndexShards::Scored>> got = index->QueryDistances(ask);
-    if (got.ok()) {
-      distances[p] = *std::move(got);
-    } else {
-      errors[p] = got.status();
-    }
-  });
-  for (const absl::Status& e : errors) MESHSEEK_RETURN_IF_ERROR(e);
-  return distances;
-}
-
 std::vector<IndexShards::Part> IndexParts(const CollectionPlan& plan) {
   std::vector<IndexShards::Part> parts;
   for (const CollectionInfo& part : plan.parts) {
@@ -376,7 +346,9 @@ std::vector<IndexShards::Part> IndexParts(const CollectionPlan& plan) {
   return parts;
 }
 
-absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index, const CollectionPlan& plan) {
+absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index,
+                                                 const CollectionPlan& plan,
+                                                 const RankingGraphOptions& graph_options) {
   const std::vector<IndexShards::Part> parts = IndexParts(plan);
   const CollectionOptions& options = plan.options;
   RankingState state;
@@ -409,7 +381,23 @@ absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index, const Colle
   for (const DistanceScale& s : scales) state.scales.push_back(s.Scale());
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<double> factors,
                             FusionFactors(options.weights, state.scales));
-  // Pass 2: the models, and the graph of the fused rows.
+  // Pass 2: the models, and the graph of the fused rows: from candidates
+  // above the exact graph's size (fused_candidates.h).
+  if (options.rerank.enabled() && n > graph_options.exact_graph_models) {
+    MESHSEEK_ASSIGN_OR_RETURN(const IndexShards::PartModels models, index->ExportParts(parts));
+    if (models.size() != n) {
+      return absl::AbortedError("the collection changed during its build; build again");
+    }
+    for (const v1::IndexedModel& m : models.models[0]) {
+      state.model_ids.push_back(m.model_id());
+      state.ordinals.push_back(m.ordinal());
+      state.labels.push_back(m.label());
+    }
+    MESHSEEK_ASSIGN_OR_RETURN(state.graph,
+                              ApproximateNeighborGraph(index, plan, models, factors,
+                                                       options.rerank.graph_k(), graph_options));
+    return state;
+  }
   if (options.rerank.enabled()) {
     MESHSEEK_ASSIGN_OR_RETURN(state.graph, NeighborGraph::Create(n, options.rerank.graph_k()));
   }

@@ -18,7 +18,10 @@
 //
 // Cost of a build's ranking step: two passes over the parts' distances, the
 // sample rows then all rows (O(N^2) distances, in blocks of IndexShards'
-// kMatrixBatch rows), and a partial sort per row. Memory: the state is
+// kMatrixBatch rows), and a partial sort per row; above
+// RankingGraphOptions::exact_graph_models the second pass is the approximate
+// graph's O(N x candidates) distances instead (docs/design.md "Approximate
+// neighbour graph"). The sample rows stay O(N x kScaleRows). Memory: the state is
 // about 12 bytes per neighbour (k1 + 1 per model) plus ids and labels.
 #ifndef MESHSEEK_SERVICES_COORDINATOR_RANKING_H_
 #define MESHSEEK_SERVICES_COORDINATOR_RANKING_H_
@@ -34,6 +37,7 @@
 #include "absl/types/span.h"
 #include "common/search/neighbor_graph.h"
 #include "meshseek/v1/types.pb.h"
+#include "services/coordinator/coordinator_options.h"
 #include "services/coordinator/index_shards.h"
 #include "services/coordinator/workers.h"
 
@@ -116,15 +120,12 @@ struct Ranking {
 };
 
 /// The state of `plan` after a build indexed every part: scales over the
-/// sample rows, then the graph of every fused row (re-ranked collections).
-absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index, const CollectionPlan& plan);
-
-/// Each part's distances from its signature (one per part, in part order)
-/// to every model of the part, the parts asked at once.
-absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> PartDistances(
-    IndexShards* index,
-    const CollectionPlan& plan,
-    const std::vector<const IndexSignature*>& signatures);
+/// sample rows, then the graph of every fused row (re-ranked collections),
+/// from all pairs up to graph.exact_graph_models models and from candidates
+/// above (fused_candidates.h).
+absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index,
+                                                 const CollectionPlan& plan,
+                                                 const RankingGraphOptions& graph);
 
 /// The parts of `plan` as IndexShards parts.
 std::vector<IndexShards::Part> IndexParts(const CollectionPlan& plan);

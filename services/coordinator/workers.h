@@ -80,6 +80,8 @@ class Workers {
   /// `stop` (not owned) ends retries early when the coordinator stops.
   Workers(const CoordinatorOptions& options, const std::atomic<bool>* stop);
 
+  const CoordinatorOptions& options() const { return options_; }
+
   /// Resamples (RLD-SIFT) and extracts one mesh.
   absl::StatusOr<v1::LocalFeatures> Extract(const v1::Mesh& mesh,
                                             const CollectionInfo& collection,
