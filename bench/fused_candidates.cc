@@ -44,6 +44,8 @@ ABSL_FLAG(std::string, manifest, "", "CSV manifest id,class,path (the matrices' 
 ABSL_FLAG(std::string, eval, "", "the folder an in-process eval of the fused collection wrote");
 ABSL_FLAG(std::string, candidates, "10,25,50,100,200",
           "query candidates per method, comma-separated");
+ABSL_FLAG(bool, global_proposes, false,
+          "global methods (LFD) propose candidates too (the services: only the histogram methods)");
 ABSL_FLAG(std::string, graph_candidates, "10,25,50,100",
           "candidates per method of an approximate neighbour graph, comma-separated");
 
@@ -79,12 +81,16 @@ absl::StatusOr<std::vector<std::size_t>> Counts(const absl::Flag<std::string>& f
 
 // The union of each method's c nearest to model i.
 std::vector<uint32_t> Proposed(const std::vector<std::vector<float>>& matrices,
+                               const std::vector<bool>& proposes,
                                std::size_t n,
                                std::size_t i,
                                std::size_t c) {
   std::set<uint32_t> proposed;
-  for (const std::vector<float>& m : matrices) {
-    for (uint32_t j : Top(absl::MakeConstSpan(m).subspan(i * n, n), c)) proposed.insert(j);
+  for (std::size_t m = 0; m < matrices.size(); ++m) {
+    if (!proposes[m]) continue;
+    for (uint32_t j : Top(absl::MakeConstSpan(matrices[m]).subspan(i * n, n), c)) {
+      proposed.insert(j);
+    }
   }
   return std::vector<uint32_t>(proposed.begin(), proposed.end());
 }
@@ -119,6 +125,13 @@ int Run() {
     return 2;
   }
   const std::size_t n = models->size();
+  // Which methods propose candidates: the histogram methods, and the global
+  // ones only when asked (the services do not ask them: their index scans).
+  std::vector<bool> proposes;
+  for (const RetrievalPipelineOptions& method : options->methods) {
+    proposes.push_back(absl::GetFlag(FLAGS_global_proposes) ||
+                       FeatureMethodInfoOf(method.extractor.method).kind != DescriptorKind::kGlobal);
+  }
   std::vector<std::vector<float>> matrices;
   for (const RetrievalPipelineOptions& method : options->methods) {
     const std::string path = absl::StrCat(absl::GetFlag(FLAGS_eval), "/distances.",
@@ -164,7 +177,7 @@ int Run() {
     double recall_sum = 0, union_sum = 0, worst = 1;
     std::size_t all_ten = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      const std::vector<uint32_t> proposed = Proposed(matrices, n, i, c);
+      const std::vector<uint32_t> proposed = Proposed(matrices, proposes, n, i, c);
       const std::vector<float> got =
           *RerankRow(graph, Restricted(fused, n, i, proposed), std::nullopt, options->rerank);
       std::copy(got.begin(), got.end(), ranked.begin() + i * n);
@@ -198,7 +211,7 @@ int Run() {
     NeighborGraph approximate = *NeighborGraph::Create(n, k);
     double union_sum = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      const std::vector<uint32_t> proposed = Proposed(matrices, n, i, c);
+      const std::vector<uint32_t> proposed = Proposed(matrices, proposes, n, i, c);
       union_sum += static_cast<double>(proposed.size());
       approximate.SetRow(static_cast<uint32_t>(i), Restricted(fused, n, i, proposed));
     }

@@ -38,7 +38,8 @@ ABSL_FLAG(int, top_k, 10, "query: results to print");
 ABSL_FLAG(int, candidates, 0,
           "query: 0 searches exactly; N re-ranks the N candidates an embedding proposes "
           "(faster on large collections, may miss a neighbour); on a fused collection each "
-          "method proposes N and their union is fused and re-ranked");
+          "histogram method proposes N and their union is fused and re-ranked (100: recall@10 "
+          "0.99 on the development sets)");
 ABSL_FLAG(std::string, job, "", "status: a job id to follow until it ends");
 ABSL_FLAG(int,
           metrics_port,

@@ -1,0 +1,231 @@
+// The default fusion at collection scale, on real index servers: synthetic
+// member histograms shaped like the four methods' real ones (each method's
+// vocabulary and its median local features a McGill model, from
+// metrics.json), added to meshseek-index processes over gRPC; then the
+// coordinator's own code (IndexShards, ComputeRankingState, Ranking,
+// fused_candidates.h) in this process builds the ranking state and answers
+// fused queries, timed:
+//
+//   fused_scale_benchmark --models 10000 [--shards 1] [--candidates 50]
+//     [--graph_candidates 50] [--exact_graph_models 0] [--queries 100]
+//     [--method bfdsift+rld+lsf+lfd]
+//
+// Prints the add time, the ranking-state build time (approximate graph above
+// --exact_graph_models), the search part of fused queries (after
+// extraction: new synthetic signatures) with and without candidates, p50 and
+// p95, and the peak resident memory of each index server and of this process
+// (the coordinator's share: it holds every signature while it builds).
+// What it leaves out of the services: the coordinator's SQLite store and
+// extraction (the extraction of a query is bench/extract_benchmark's).
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "absl/flags/flag.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "bench/synthetic_histograms.h"
+#include "cli/pipeline_flags.h"
+#include "common/base/parallel.h"
+#include "common/global/lfd.h"
+#include "common/rpc/convert.h"
+#include "common/rpc/free_port.h"
+#include "services/coordinator/fused_candidates.h"
+#include "services/coordinator/ranking.h"
+
+ABSL_FLAG(int, models, 1000, "models in the collection");
+ABSL_FLAG(int, shards, 1, "index servers");
+ABSL_FLAG(uint32_t, candidates, 50, "query candidates per method");
+ABSL_FLAG(uint32_t, graph_candidates, 50, "candidates per method of the approximate graph");
+ABSL_FLAG(int64_t, exact_graph_models, 0, "all pairs up to this many models");
+ABSL_FLAG(int, queries, 100, "fused queries timed, each way");
+ABSL_FLAG(std::string, work_dir, "", "the index servers' data (default: a temporary folder)");
+
+namespace meshseek {
+namespace {
+
+// Median local features a McGill model (bench/results/fused_candidates.txt's
+// eval, metrics.json): the word counts the synthetic histograms draw.
+int FeaturesPerModel(FeatureMethod method) {
+  switch (method) {
+    case FeatureMethod::kBfDsift: return 25212;
+    case FeatureMethod::kRldSift: return 3791;
+    case FeatureMethod::kLsf: return 2048;
+    default: return 3000;
+  }
+}
+
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Peak resident memory of a process, from /proc (VmHWM), in MB.
+double PeakMb(pid_t pid) {
+  std::ifstream status(absl::StrCat("/proc/", pid == 0 ? "self" : std::to_string(pid), "/status"));
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  }
+  return -1;
+}
+
+std::string Percentiles(std::vector<double> ms) {
+  std::sort(ms.begin(), ms.end());
+  const auto at = [&](double q) { return ms[std::min(ms.size() - 1, std::size_t(q * ms.size()))]; };
+  return absl::StrCat("p50 ", at(0.5), " ms, p95 ", at(0.95), " ms");
+}
+
+// A member's synthetic signature.
+IndexSignature Signature(std::mt19937_64& rng, const RetrievalPipelineOptions& method) {
+  IndexSignature s;
+  if (method.extractor.method == FeatureMethod::kLfd) {
+    std::string bytes(kLfdDescriptorBytes, '\0');
+    for (std::size_t i = 0; i < bytes.size(); ++i) {
+      if (i % kLfdViewStride < kLfdCoefficientsPerView) bytes[i] = static_cast<char>(rng() % 64);
+    }
+    v1::GlobalDescriptor d;
+    d.set_method("lfd");
+    d.set_data(bytes);
+    s.descriptor = d;
+    return s;
+  }
+  rpc::SparseHistogramToProto(
+      SyntheticHistogram(rng, static_cast<int>(method.kmeans.num_centroids),
+                         FeaturesPerModel(method.extractor.method)),
+      &s.histogram);
+  return s;
+}
+
+int Run() {
+  absl::StatusOr<CollectionOptions> options = cli::CollectionOptionsFromFlags();
+  if (!options.ok() || !options->rescaled()) {
+    std::fprintf(stderr, "--method must name a fused or re-ranked collection\n");
+    return 2;
+  }
+  const int n = absl::GetFlag(FLAGS_models);
+  std::string work = absl::GetFlag(FLAGS_work_dir);
+  if (work.empty()) work = std::filesystem::temp_directory_path() / absl::StrCat("fused-scale-", getpid());
+  // The index servers.
+  std::vector<pid_t> servers;
+  std::vector<std::string> targets;
+  for (int s = 0; s < absl::GetFlag(FLAGS_shards); ++s) {
+    const int port = rpc::FreeLoopbackPort();
+    const std::string dir = absl::StrCat(work, "/index-", s);
+    std::filesystem::create_directories(dir);
+    const pid_t pid = fork();
+    if (pid == 0) {
+      const std::string log = dir + "/log";
+      freopen(log.c_str(), "w", stderr);
+      execl(MESHSEEK_INDEX_PATH, MESHSEEK_INDEX_PATH, absl::StrCat("--port=", port).c_str(),
+            absl::StrCat("--data_dir=", dir).c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    servers.push_back(pid);
+    targets.push_back(absl::StrCat("127.0.0.1:", port));
+  }
+  const std::atomic<bool> stop{false};
+  IndexShards index(targets, rpc::ChannelOptions{}, absl::Minutes(10), rpc::RetryOptions{}, &stop);
+  CollectionPlan plan;
+  plan.name = "scale";
+  plan.options = *options;
+  for (const RetrievalPipelineOptions& method : options->methods) {
+    CollectionInfo part;
+    part.name = MemberCollectionName(plan.name, method.extractor.method);
+    part.options = method;
+    plan.parts.push_back(part);
+  }
+  // 1. Adds, several in flight (the first waits for the servers to start).
+  auto start = std::chrono::steady_clock::now();
+  std::vector<absl::Status> errors(n);
+  ParallelFor(static_cast<std::size_t>(n), 8, [&](std::size_t i) {
+    std::mt19937_64 rng(i + 1);
+    for (const CollectionInfo& part : plan.parts) {
+      const IndexSignature s = Signature(rng, part.options);
+      v1::AddModelRequest add;
+      add.set_collection(part.name);
+      add.set_model_id(absl::StrCat("m", i));
+      add.set_ordinal(i);
+      add.set_label(absl::StrCat("c", i % 50));
+      if (s.descriptor.has_value()) {
+        *add.mutable_global_descriptor() = *s.descriptor;
+      } else {
+        *add.mutable_histogram() = s.histogram;
+      }
+      errors[i] = index.Add(add);
+      if (!errors[i].ok()) return;
+    }
+  });
+  for (const absl::Status& e : errors) {
+    if (!e.ok()) {
+      std::fprintf(stderr, "add: %s\n", e.ToString().c_str());
+      return 1;
+    }
+  }
+  std::printf("%d models, %s, %zu index shard(s): added in %.1f s\n", n,
+              options->MethodName().c_str(), targets.size(), Seconds(start));
+  // 2. The ranking state.
+  RankingGraphOptions graph;
+  graph.exact_graph_models = static_cast<std::size_t>(absl::GetFlag(FLAGS_exact_graph_models));
+  graph.graph_candidates = absl::GetFlag(FLAGS_graph_candidates);
+  start = std::chrono::steady_clock::now();
+  absl::StatusOr<RankingState> state = ComputeRankingState(&index, plan, graph);
+  if (!state.ok()) {
+    std::fprintf(stderr, "ranking state: %s\n", state.status().ToString().c_str());
+    return 1;
+  }
+  std::printf("ranking state (%s graph, %u candidates a method): %.1f s, %zu bytes\n",
+              static_cast<std::size_t>(n) > graph.exact_graph_models ? "approximate" : "exact",
+              graph.graph_candidates, Seconds(start), state->Serialize().size());
+  absl::StatusOr<Ranking> ranking = Ranking::Make("bench", *std::move(state), plan.options);
+  if (!ranking.ok()) return 1;
+  // 3. Fused queries: new signatures, exact and with candidates.
+  std::mt19937_64 rng(0xfeed);
+  std::vector<std::vector<IndexSignature>> queries(absl::GetFlag(FLAGS_queries));
+  for (auto& q : queries) {
+    for (const CollectionInfo& part : plan.parts) q.push_back(Signature(rng, part.options));
+  }
+  for (const uint32_t candidates : {0u, absl::GetFlag(FLAGS_candidates)}) {
+    std::vector<double> ms;
+    for (const auto& q : queries) {
+      std::vector<const IndexSignature*> signatures;
+      for (const IndexSignature& s : q) signatures.push_back(&s);
+      const auto t = std::chrono::steady_clock::now();
+      auto distances = candidates == 0 ? PartDistances(&index, plan, signatures)
+                                       : CandidatePartDistances(&index, plan, signatures, candidates);
+      if (!distances.ok()) return 1;
+      auto found = ranking->Query(*distances, plan.options, 10);
+      if (!found.ok()) return 1;
+      ms.push_back(Seconds(t) * 1e3);
+    }
+    std::printf("fused query, search part, %s: %s\n",
+                candidates == 0 ? "exact" : absl::StrCat(candidates, " candidates").c_str(),
+                Percentiles(ms).c_str());
+  }
+  for (std::size_t s = 0; s < servers.size(); ++s) {
+    std::printf("index shard %zu: peak RSS %.0f MB\n", s, PeakMb(servers[s]));
+    kill(servers[s], SIGTERM);
+    waitpid(servers[s], nullptr, 0);
+  }
+  std::printf("this process (the coordinator's code): peak RSS %.0f MB\n", PeakMb(0));
+  std::error_code ec;
+  if (absl::GetFlag(FLAGS_work_dir).empty()) std::filesystem::remove_all(work, ec);
+  return 0;
+}
+
+}  // namespace
+}  // namespace meshseek
+
+int main(int argc, char** argv) {
+  meshseek::cli::ParseCommandLineWithParams(argc, argv, "fused_scale_benchmark --models N");
+  return meshseek::Run();
+}
