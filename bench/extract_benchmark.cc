@@ -7,7 +7,9 @@
 // of each on the calling thread. Counters: median and 90th-percentile
 // milliseconds per model over the set (wall clock, and the thread's CPU time,
 // which other processes on a shared machine disturb less), mean vertices, and
-// local features per model. BM_ExtractRldSamples/N times RLD-SIFT at N
+// local features per model; on stderr, a fingerprint of every feature of the
+// set (FNV-1a 64 of keypoints and descriptors, model by model), so that a
+// change meant to leave features bit-identical can be checked on real meshes. BM_ExtractRldSamples/N times RLD-SIFT at N
 // resample points (how its cost grows with N_RLD). Without --models_dir, a
 // built-in lumpy sphere is used (a smoke run).
 #include <benchmark/benchmark.h>
@@ -27,6 +29,7 @@
 #include "absl/strings/str_cat.h"
 #include "bench/bench_models.h"
 #include "cli/pipeline_flags.h"
+#include "common/base/hash.h"
 #include "common/features/local_feature_extractor.h"
 #include "common/geometry/mesh_io.h"
 #include "common/geometry/test_meshes.h"
@@ -60,6 +63,7 @@ void TimeExtraction(benchmark::State& state, const ExtractorOptions& options) {
   const std::vector<TriangleMesh>& meshes = Models();
   std::vector<double> per_model_ms, per_model_cpu_ms;
   double vertices = 0, features = 0;
+  uint64_t fingerprint = kFnv1a64OffsetBasis;
   for (const auto& m : meshes) vertices += m.vertices.size();
   for (auto _ : state) {
     for (const TriangleMesh& mesh : meshes) {
@@ -75,8 +79,19 @@ void TimeExtraction(benchmark::State& state, const ExtractorOptions& options) {
         return;
       }
       features += extracted->size();
+      fingerprint = Fnv1a64(
+          absl::string_view(reinterpret_cast<const char*>(extracted->keypoints.data()),
+                            extracted->keypoints.size() * sizeof(Keypoint)),
+          fingerprint);
+      fingerprint = Fnv1a64(
+          absl::string_view(reinterpret_cast<const char*>(extracted->descriptors.data()),
+                            extracted->descriptors.size()),
+          fingerprint);
     }
   }
+  std::cerr << FeatureMethodInfoOf(options.method).name << " on " << meshes.size()
+            << " models: features fingerprint " << std::hex << fingerprint << std::dec
+            << "\n";
   std::sort(per_model_ms.begin(), per_model_ms.end());
   std::sort(per_model_cpu_ms.begin(), per_model_cpu_ms.end());
   state.counters["models"] = static_cast<double>(meshes.size());

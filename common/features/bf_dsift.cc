@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "common/base/cpu_features.h"
 #include "common/base/status_macros.h"
 #include "common/geometry/icosphere.h"
 #include "common/render/view_renderer.h"
@@ -17,21 +18,82 @@ namespace {
 struct DistancePyramid {
   std::vector<std::vector<float>> levels;
   std::vector<int> sizes;
-
-  float Sample(int level, double x, double y) const {
-    // Bilinear at continuous coordinates of level 0 (pixel p spans [p, p+1)).
-    const double scale = 1.0 / (1 << level);
-    const int n = sizes[level];
-    const double u = std::clamp(x * scale - 0.5, 0.0, n - 1.0);
-    const double v = std::clamp(y * scale - 0.5, 0.0, n - 1.0);
-    const int x0 = std::min(static_cast<int>(u), n - 2), y0 = std::min(static_cast<int>(v), n - 2);
-    const double fx = u - x0, fy = v - y0;
-    const std::vector<float>& d = levels[level];
-    const auto at = [&](int xx, int yy) { return d[static_cast<std::size_t>(yy) * n + xx]; };
-    return static_cast<float>((1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) +
-                              fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1)));
-  }
 };
+
+// Resamples patches from a pyramid level: each pixel centre of the patch is
+// sampled bilinearly at continuous level-0 coordinates (pixel p spans
+// [p, p + 1)), horizontally first, in double. What depends on one coordinate
+// only is computed once: a column's source pixel and fraction, and a source
+// row's horizontal interpolation, which consecutive patch rows share whenever
+// the patch is finer than the level (the smaller radii). Holds its scratch:
+// one per thread.
+class PatchResampler {
+ public:
+  // The patch of `radius` level-0 pixels around pixel (px, py) from `level`,
+  // as depths from the plane `near` clipped to [0, 2 radius], into `patch`
+  // (patch->size pixels square, already sized).
+  MESHSEEK_TARGET_CLONES_AVX void Resample(const DistancePyramid& pyramid,
+                                           int level,
+                                           int px,
+                                           int py,
+                                           double radius,
+                                           double near,
+                                           DepthImage* patch);
+
+ private:
+  void InterpolateRow(const float* source, std::vector<double>* out) const {
+    for (std::size_t col = 0; col < x0_.size(); ++col) {
+      (*out)[col] = (1 - fx_[col]) * source[x0_[col]] + fx_[col] * source[x0_[col] + 1];
+    }
+  }
+
+  std::vector<int> x0_;
+  std::vector<double> fx_;
+  std::vector<double> upper_, lower_;  // source rows y0 and y0 + 1, interpolated
+};
+
+void PatchResampler::Resample(const DistancePyramid& pyramid,
+                              int level,
+                              int px,
+                              int py,
+                              double radius,
+                              double near,
+                              DepthImage* patch) {
+  const int image = patch->size;
+  const double scale = 1.0 / (1 << level);
+  const int n = pyramid.sizes[level];
+  const float* distances = pyramid.levels[level].data();
+  x0_.resize(image);
+  fx_.resize(image);
+  upper_.resize(image);
+  lower_.resize(image);
+  for (int col = 0; col < image; ++col) {
+    const double x = px + 0.5 + ((col + 0.5) / image * 2 - 1) * radius;
+    const double u = std::clamp(x * scale - 0.5, 0.0, n - 1.0);
+    x0_[col] = std::min(static_cast<int>(u), n - 2);
+    fx_[col] = u - x0_[col];
+  }
+  int upper_row = -2;  // the source row upper_ holds
+  for (int row = 0; row < image; ++row) {
+    const double y = py + 0.5 + ((row + 0.5) / image * 2 - 1) * radius;
+    const double v = std::clamp(y * scale - 0.5, 0.0, n - 1.0);
+    const int y0 = std::min(static_cast<int>(v), n - 2);
+    const double fy = v - y0;
+    if (y0 == upper_row + 1) {
+      std::swap(upper_, lower_);
+      InterpolateRow(distances + static_cast<std::size_t>(y0 + 1) * n, &lower_);
+    } else if (y0 != upper_row) {
+      InterpolateRow(distances + static_cast<std::size_t>(y0) * n, &upper_);
+      InterpolateRow(distances + static_cast<std::size_t>(y0 + 1) * n, &lower_);
+    }
+    upper_row = y0;
+    float* out = &patch->depth[static_cast<std::size_t>(row) * image];
+    for (int col = 0; col < image; ++col) {
+      const float sampled = static_cast<float>((1 - fy) * upper_[col] + fy * lower_[col]);
+      out[col] = static_cast<float>(std::clamp(sampled - near, 0.0, 2 * radius));
+    }
+  }
+}
 
 DistancePyramid BuildPyramid(const ViewImage& view, int max_levels) {
   DistancePyramid pyramid;
@@ -103,6 +165,7 @@ absl::StatusOr<LocalFeatures> ExtractBfDsift(const TriangleMesh& mesh,
 
   LocalFeatures features;
   DepthSiftDescriber describer(options.descriptor);
+  PatchResampler resampler;
   DepthImage patch;
   patch.size = image;
   patch.depth.resize(static_cast<std::size_t>(image) * image);
@@ -130,15 +193,7 @@ absl::StatusOr<LocalFeatures> ExtractBfDsift(const TriangleMesh& mesh,
                          0,
                          static_cast<int>(pyramid.levels.size()) - 1);
           patch.support_radius = static_cast<float>(radius);
-          const double near = centre - radius;
-          for (int row = 0; row < image; ++row) {
-            const double y = py + 0.5 + ((row + 0.5) / image * 2 - 1) * radius;
-            for (int col = 0; col < image; ++col) {
-              const double x = px + 0.5 + ((col + 0.5) / image * 2 - 1) * radius;
-              const double d = pyramid.Sample(level, x, y) - near;
-              patch.at(row, col) = static_cast<float>(std::clamp(d, 0.0, 2 * radius));
-            }
-          }
+          resampler.Resample(pyramid, level, px, py, radius, centre - radius, &patch);
           const int added = describer.Describe(patch, &features.descriptors);
           // The surface point at the patch centre, back in model units.
           const double a = (px + 0.5) / n * 2 - 1, b = 1 - (py + 0.5) / n * 2;

@@ -45,6 +45,25 @@ inline float FastAtan2Degrees(float y, float x) {
   return y < 0 ? 360.0f - a : a;
 }
 
+// out[c] = sum_k kernel[k] tap[k][c] for c < width (a multiple of 16), summed
+// in tap order from 0 as a row-at-a-time accumulation would: each 16 columns
+// stay in registers over the taps instead of going through memory per tap.
+MESHSEEK_TARGET_CLONES_AVX void WeightedRowSum(int taps,
+                                               const float* __restrict kernel,
+                                               const float* const* __restrict tap,
+                                               int width,
+                                               float* __restrict out) {
+  for (int c0 = 0; c0 < width; c0 += 16) {
+    float sum[16] = {};
+    for (int k = 0; k < taps; ++k) {
+      const float w = kernel[k];
+      const float* __restrict in = tap[k] + c0;
+      for (int j = 0; j < 16; ++j) sum[j] += w * in[j];
+    }
+    for (int j = 0; j < 16; ++j) out[c0 + j] = sum[j];
+  }
+}
+
 // cv::borderInterpolate with BORDER_REFLECT_101 (GaussianBlur's default):
 // ... 2 1 | 0 1 2 ... n-1 | n-2 n-3 ...
 int Reflect101(int p, int n) {
@@ -53,29 +72,51 @@ int Reflect101(int p, int n) {
   return p;
 }
 
+constexpr int kOrientationHistogramBins = 36;
+
+// Gradient magnitude and orientation-histogram bin of every interior pixel of
+// `image` (row-major, image-sized; border entries untouched): the vectorisable
+// half of FindDominantOrientations, compiled wider like ComputeSamples.
+MESHSEEK_TARGET_CLONES_AVX void OrientationGradients(const DepthImage& image,
+                                                     float* __restrict magnitude,
+                                                     int* __restrict bin) {
+  constexpr int kBins = kOrientationHistogramBins;
+  const int size = image.size;
+  const float* __restrict depth = image.depth.data();
+  // Rows 1 .. size - 2 as one flat array: the border columns' values (which
+  // wrap around a row's ends) are computed too and never read.
+  for (int i = size, end = (size - 1) * size; i < end; ++i) {
+    const float dx = depth[i + 1] - depth[i - 1];
+    const float dy = depth[i - size] - depth[i + size];  // y up
+    magnitude[i] = std::sqrt(dx * dx + dy * dy);
+    bin[i] = static_cast<int>(FastAtan2Degrees(dy, dx) * kBins / 360.0f) % kBins;
+  }
+}
+
 // Lowe's dominant orientations (see DominantOrientations) with the Gaussian
-// weight of each pixel given (row-major, image-sized), into `angles`.
+// weight of each pixel given (row-major, image-sized), into `angles`;
+// `magnitude` and `bin` are image-sized scratch.
 void FindDominantOrientations(const DepthImage& image,
                               const float* weight,
                               float peak_ratio,
+                              std::vector<float>* magnitude,
+                              std::vector<int>* bin,
                               std::vector<float>* angles) {
-  constexpr int kBins = 36;
+  constexpr int kBins = kOrientationHistogramBins;
   const int size = image.size;
   angles->clear();
+  magnitude->resize(image.depth.size());
+  bin->resize(image.depth.size());
+  OrientationGradients(image, magnitude->data(), bin->data());
   float hist[kBins] = {};
+  // Summed in pixel order, as one pass computing the gradients would.
   for (int r = 1; r + 1 < size; ++r) {
-    const float* above = &image.depth[static_cast<std::size_t>(r - 1) * size];
-    const float* row = above + size;
-    const float* below = row + size;
-    const float* w = weight + static_cast<std::size_t>(r) * size;
+    const std::size_t at = static_cast<std::size_t>(r) * size;
+    const float* m = magnitude->data() + at;
+    const int* b = bin->data() + at;
+    const float* w = weight + at;
     for (int c = 1; c + 1 < size; ++c) {
-      const float dx = row[c + 1] - row[c - 1];
-      const float dy = above[c] - below[c];  // y up
-      const float magnitude = std::sqrt(dx * dx + dy * dy);
-      if (magnitude <= 0) continue;
-      const float angle = FastAtan2Degrees(dy, dx);
-      const int bin = static_cast<int>(angle * kBins / 360.0f) % kBins;
-      hist[bin] += magnitude * w[c];
+      if (!(m[c] <= 0)) hist[b[c]] += m[c] * w[c];
     }
   }
   float smooth[kBins];
@@ -160,9 +201,10 @@ void NormalizeSiftDescriptor(float* bins, uint8_t* out) {
 }
 
 std::vector<float> DominantOrientations(const DepthImage& image, float peak_ratio) {
-  std::vector<float> weight, angles;
+  std::vector<float> weight, magnitude, angles;
+  std::vector<int> bin;
   OrientationWeights(image.size, &weight);
-  FindDominantOrientations(image, weight.data(), peak_ratio, &angles);
+  FindDominantOrientations(image, weight.data(), peak_ratio, &magnitude, &bin, &angles);
   return angles;
 }
 
@@ -184,49 +226,62 @@ DepthSiftDescriber::DepthSiftDescriber(const SiftDescriptorOptions& options)
     sum += kernel[k];
   }
   for (const double k : kernel) kernel_.push_back(static_cast<float>(k / sum));
+  tap_rows_.resize(taps);
 }
 
 void DepthSiftDescriber::Prepare(int size) {
   if (size == size_) return;
   size_ = size;
+  // Rows of the working images are padded to whole 512-bit vectors (16
+  // floats), so that every loop over a row, or over the image as one flat
+  // array, runs in whole vectors; padding is finite and weighs nothing.
+  stride_ = (size + 15) / 16 * 16;
+  const std::size_t pixels = static_cast<std::size_t>(size) * stride_;
   const int padded = size + 2 * blur_radius_;
   border_.resize(padded);
   for (int p = 0; p < padded; ++p) border_[p] = Reflect101(p - blur_radius_, size);
   // The descriptor window's Gaussian: sigma = half the window (2 cells) in
-  // cell units, cells of 3 keypoint sigmas, keypoint sigma I / 12.
+  // cell units, cells of 3 keypoint sigmas, keypoint sigma I / 12. Zero off
+  // the interior: border pixels have no central difference, padding no pixel.
   const float cell = kCellSigmas * (size / 12.0f);
   const float scale = -1.0f / (kCells * kCells * 0.5f) / (cell * cell);
   const int centre = size / 2;
-  window_weight_.resize(static_cast<std::size_t>(size) * size);
-  for (int r = 0; r < size; ++r) {
-    for (int c = 0; c < size; ++c) {
+  window_weight_.assign(pixels, 0.0f);
+  for (int r = 1; r + 1 < size; ++r) {
+    for (int c = 1; c + 1 < size; ++c) {
       const float d2 = static_cast<float>((r - centre) * (r - centre) + (c - centre) * (c - centre));
-      window_weight_[static_cast<std::size_t>(r) * size + c] = std::exp(d2 * scale);
+      window_weight_[static_cast<std::size_t>(r) * stride_ + c] = std::exp(d2 * scale);
     }
   }
   OrientationWeights(size, &orientation_weight_);
-  gray_.resize(static_cast<std::size_t>(size) * size);
-  rows_.resize(gray_.size());
-  blurred_.resize(gray_.size());
-  padded_.resize(padded);
-  // One sample per interior pixel, row by row: calcSIFTDescriptor's window
-  // (radius 0.88 I) always covers the whole image, and its border pixels have
-  // no central difference. The offsets are fixed; ComputeSamples fills in the
-  // gradients.
-  samples_.clear();
+  gray_.assign(pixels, 0.0f);
+  rows_.assign(pixels, 0.0f);
+  blurred_.assign(pixels, 0.0f);
+  padded_.assign(stride_ + 2 * blur_radius_, 0.0f);
+  // One sample per pixel of rows 1 .. size - 2, row by row, padding
+  // included: calcSIFTDescriptor's window (radius 0.88 I) always covers the
+  // whole image, and only interior pixels have a weight (so a gradient). The
+  // offsets are fixed; ComputeSamples fills in the gradients.
+  sample_row_.clear();
+  sample_col_.clear();
   for (int r = 1; r + 1 < size; ++r) {
-    for (int c = 1; c + 1 < size; ++c) {
-      samples_.push_back(
-          {static_cast<float>(r - centre), static_cast<float>(c - centre), 0.0f, 0.0f});
+    for (int c = 0; c < stride_; ++c) {
+      sample_row_.push_back(static_cast<float>(r - centre));
+      sample_col_.push_back(static_cast<float>(c - centre));
     }
   }
+  const std::size_t samples = sample_row_.size();
+  sample_orientation_.assign(samples, 0.0f);
+  sample_magnitude_.assign(samples, 0.0f);
+  sample_offset_.assign(samples, 0);
+  for (auto& weights : sample_weights_) weights.assign(samples, 0.0f);
 }
 
 // Compiled for AVX-512 and AVX2 as well, picked at run time: the blur and
 // gradient loops vectorise wider, with the same operations per lane.
 MESHSEEK_TARGET_CLONES_AVX void
 DepthSiftDescriber::ComputeSamples(const DepthImage& image) {
-  const int size = size_;
+  const int size = size_, stride = stride_;
   float lo = 0, hi = 2 * image.support_radius;
   if (options_.depth_to_gray == DepthToGray::kStretch) {
     const auto [mn, mx] = std::minmax_element(image.depth.begin(), image.depth.end());
@@ -234,77 +289,99 @@ DepthSiftDescriber::ComputeSamples(const DepthImage& image) {
     hi = *mx;
   }
   const float scale = hi > lo ? 255.0f / (hi - lo) : 0.0f;
-  for (std::size_t i = 0; i < gray_.size(); ++i) {
-    // Rounded half up, as std::lround for these non-negative values.
-    const float g = std::clamp((image.depth[i] - lo) * scale, 0.0f, 255.0f);
-    gray_[i] = static_cast<float>(static_cast<int>(g + 0.5f));
+  for (int r = 0; r < size; ++r) {
+    const float* __restrict in = &image.depth[static_cast<std::size_t>(r) * size];
+    float* __restrict gray = &gray_[static_cast<std::size_t>(r) * stride];
+    for (int c = 0; c < size; ++c) {
+      // Rounded half up, as std::lround for these non-negative values.
+      const float g = std::clamp((in[c] - lo) * scale, 0.0f, 255.0f);
+      gray[c] = static_cast<float>(static_cast<int>(g + 0.5f));
+    }
   }
   // Separable blur, rows then columns, borders reflected as OpenCV does.
   const int taps = static_cast<int>(kernel_.size());
+  const float** tap = tap_rows_.data();
   for (int r = 0; r < size; ++r) {
-    const float* in = &gray_[static_cast<std::size_t>(r) * size];
+    const float* in = &gray_[static_cast<std::size_t>(r) * stride];
     for (std::size_t p = 0; p < border_.size(); ++p) padded_[p] = in[border_[p]];
-    float* out = &rows_[static_cast<std::size_t>(r) * size];
-    std::fill(out, out + size, 0.0f);
-    for (int k = 0; k < taps; ++k) {
-      const float w = kernel_[k];
-      const float* shifted = &padded_[k];
-      for (int c = 0; c < size; ++c) out[c] += w * shifted[c];
-    }
+    for (int k = 0; k < taps; ++k) tap[k] = &padded_[k];
+    WeightedRowSum(taps, kernel_.data(), tap, stride, &rows_[static_cast<std::size_t>(r) * stride]);
   }
   for (int r = 0; r < size; ++r) {
-    float* out = &blurred_[static_cast<std::size_t>(r) * size];
-    std::fill(out, out + size, 0.0f);
-    for (int k = 0; k < taps; ++k) {
-      const float* in = &rows_[static_cast<std::size_t>(border_[r + k]) * size];
-      const float w = kernel_[k];
-      for (int c = 0; c < size; ++c) out[c] += w * in[c];
-    }
+    for (int k = 0; k < taps; ++k) tap[k] = &rows_[static_cast<std::size_t>(border_[r + k]) * stride];
+    WeightedRowSum(taps, kernel_.data(), tap, stride, &blurred_[static_cast<std::size_t>(r) * stride]);
   }
-  // Gradients of every interior pixel (see Prepare).
-  Sample* sample = samples_.data();
-  for (int r = 1; r + 1 < size; ++r) {
-    const float* above = &blurred_[static_cast<std::size_t>(r - 1) * size];
-    const float* row = above + size;
-    const float* below = row + size;
-    const float* w = &window_weight_[static_cast<std::size_t>(r) * size];
-    for (int c = 1; c + 1 < size; ++c, ++sample) {
-      const float dx = row[c + 1] - row[c - 1];
-      const float dy = above[c] - below[c];  // y up
-      sample->orientation = FastAtan2Degrees(dy, dx);
-      sample->weighted_magnitude = std::sqrt(dx * dx + dy * dy) * w[c];
-    }
+  // Gradients of rows 1 .. size - 2 as one flat array (see Prepare): what
+  // wraps around a row's ends lands on a border or padding pixel, weight 0.
+  const float* __restrict blurred = blurred_.data();
+  const float* __restrict weight = window_weight_.data();
+  float* __restrict orientation = sample_orientation_.data();
+  float* __restrict magnitude = sample_magnitude_.data();
+  const int first = stride, end = (size - 1) * stride;
+  for (int i = first; i < end; ++i) {
+    const float dx = blurred[i + 1] - blurred[i - 1];
+    const float dy = blurred[i - stride] - blurred[i + stride];  // y up
+    orientation[i - first] = FastAtan2Degrees(dy, dx);
+    magnitude[i - first] = std::sqrt(dx * dx + dy * dy) * weight[i];
   }
 }
 
-void DepthSiftDescriber::DescribeAt(float degrees, float* bins) const {
-  const float cell = kCellSigmas * (size_ / 12.0f);
-  const float radians = degrees * static_cast<float>(M_PI / 180);
-  const float cos_t = std::cos(radians) / cell, sin_t = std::sin(radians) / cell;
+namespace {
+
+// Where each of `n` gradient samples lands in the padded histogram, and its
+// eight trilinear weights, for orientation `degrees`, in OpenCV's order of
+// operations; offset -1 for a sample outside the window or without gradient
+// (whose weights are +0: adding them would change no bin). Each sample on
+// its own, so it vectorises (compiled wider like ComputeSamples; a free
+// function because GCC honours __restrict on parameters, not on locals).
+MESHSEEK_TARGET_CLONES_AVX void BinSamplesKernel(int n,
+                                                 float degrees,
+                                                 float cos_t,
+                                                 float sin_t,
+                                                 const float* __restrict row,
+                                                 const float* __restrict col,
+                                                 const float* __restrict orientation,
+                                                 const float* __restrict magnitude,
+                                                 int* __restrict offset,
+                                                 float* __restrict w000,
+                                                 float* __restrict w001,
+                                                 float* __restrict w010,
+                                                 float* __restrict w011,
+                                                 float* __restrict w100,
+                                                 float* __restrict w101,
+                                                 float* __restrict w110,
+                                                 float* __restrict w111) {
   constexpr float kBinsPerDegree = kOrientationBins / 360.0f;
-  float hist[kHistogramSize] = {};
-  for (const Sample& s : samples_) {
+  for (int i = 0; i < n; ++i) {
     // Histogram coordinates of the sample, rotated by the orientation;
     // - 0.5 so that a sample at the centre of a cell lands there with full
     // weight after interpolation.
-    const float c_rot = s.col * cos_t - s.row * sin_t;
-    const float r_rot = s.col * sin_t + s.row * cos_t;
+    const float c_rot = col[i] * cos_t - row[i] * sin_t;
+    const float r_rot = col[i] * sin_t + row[i] * cos_t;
     float rbin = r_rot + kCells / 2 - 0.5f;
     float cbin = c_rot + kCells / 2 - 0.5f;
-    if (!(rbin > -1 && rbin < kCells && cbin > -1 && cbin < kCells)) continue;
-    float obin = (s.orientation - degrees) * kBinsPerDegree;
-    // Floors by truncation of shifted values: rbin, cbin > -1 and obin in
-    // (-8, 8] (both angles in [0, 360]).
+    float obin = (orientation[i] - degrees) * kBinsPerDegree;
+    // Floors by truncation of shifted values: rbin, cbin > -1 (inside the
+    // window; outside the sample is dropped) and obin in (-8, 8] (both
+    // angles in [0, 360]).
     const int r0 = static_cast<int>(rbin + 1.0f) - 1;
     const int c0 = static_cast<int>(cbin + 1.0f) - 1;
-    int o0 = static_cast<int>(obin + kOrientationBins) - kOrientationBins;
-    rbin -= r0;
-    cbin -= c0;
-    obin -= o0;
+    const int o0_unwrapped = static_cast<int>(obin + kOrientationBins) - kOrientationBins;
+    int o0 = o0_unwrapped;
     o0 += o0 < 0 ? kOrientationBins : 0;
     o0 -= o0 >= kOrientationBins ? kOrientationBins : 0;
-    // Trilinear interpolation, in OpenCV's order of operations.
-    const float mag = s.weighted_magnitude;
+    // Selects on 32-bit values only (a bool would make the loop's vectors
+    // bytes wide, and it stays scalar).
+    int at = ((r0 + 1) * kPaddedCells + c0 + 1) * kPaddedBins + o0;
+    at = rbin > -1 ? at : -1;
+    at = rbin < kCells ? at : -1;
+    at = cbin > -1 ? at : -1;
+    at = cbin < kCells ? at : -1;
+    const float mag = magnitude[i];
+    offset[i] = mag != 0 ? at : -1;
+    rbin -= r0;
+    cbin -= c0;
+    obin -= o0_unwrapped;
     const float v_r1 = mag * rbin, v_r0 = mag - v_r1;
     const float v_rc11 = v_r1 * cbin, v_rc10 = v_r1 - v_rc11;
     const float v_rc01 = v_r0 * cbin, v_rc00 = v_r0 - v_rc01;
@@ -312,15 +389,49 @@ void DepthSiftDescriber::DescribeAt(float degrees, float* bins) const {
     const float v_rco101 = v_rc10 * obin, v_rco100 = v_rc10 - v_rco101;
     const float v_rco011 = v_rc01 * obin, v_rco010 = v_rc01 - v_rco011;
     const float v_rco001 = v_rc00 * obin, v_rco000 = v_rc00 - v_rco001;
-    float* h = hist + ((r0 + 1) * kPaddedCells + c0 + 1) * kPaddedBins + o0;
-    h[0] += v_rco000;
-    h[1] += v_rco001;
-    h[kPaddedBins] += v_rco010;
-    h[kPaddedBins + 1] += v_rco011;
-    h[kPaddedCells * kPaddedBins] += v_rco100;
-    h[kPaddedCells * kPaddedBins + 1] += v_rco101;
-    h[(kPaddedCells + 1) * kPaddedBins] += v_rco110;
-    h[(kPaddedCells + 1) * kPaddedBins + 1] += v_rco111;
+    w000[i] = v_rco000;
+    w001[i] = v_rco001;
+    w010[i] = v_rco010;
+    w011[i] = v_rco011;
+    w100[i] = v_rco100;
+    w101[i] = v_rco101;
+    w110[i] = v_rco110;
+    w111[i] = v_rco111;
+  }
+}
+
+}  // namespace
+
+void DepthSiftDescriber::BinSamples(float degrees) {
+  const float cell = kCellSigmas * (size_ / 12.0f);
+  const float radians = degrees * static_cast<float>(M_PI / 180);
+  const float cos_t = std::cos(radians) / cell, sin_t = std::sin(radians) / cell;
+  std::vector<float>* w = sample_weights_;
+  BinSamplesKernel(static_cast<int>(sample_row_.size()), degrees, cos_t, sin_t,
+                   sample_row_.data(), sample_col_.data(), sample_orientation_.data(),
+                   sample_magnitude_.data(), sample_offset_.data(), w[0].data(), w[1].data(),
+                   w[2].data(), w[3].data(), w[4].data(), w[5].data(), w[6].data(), w[7].data());
+}
+
+void DepthSiftDescriber::DescribeAt(float degrees, float* bins) {
+  BinSamples(degrees);
+  float hist[kHistogramSize] = {};
+  const int n = static_cast<int>(sample_offset_.size());
+  const int* offset = sample_offset_.data();
+  const float* w[8];
+  for (int k = 0; k < 8; ++k) w[k] = sample_weights_[k].data();
+  for (int i = 0; i < n; ++i) {
+    if (offset[i] < 0) continue;
+    // Trilinear interpolation, in OpenCV's order of operations.
+    float* h = hist + offset[i];
+    h[0] += w[0][i];
+    h[1] += w[1][i];
+    h[kPaddedBins] += w[2][i];
+    h[kPaddedBins + 1] += w[3][i];
+    h[kPaddedCells * kPaddedBins] += w[4][i];
+    h[kPaddedCells * kPaddedBins + 1] += w[5][i];
+    h[(kPaddedCells + 1) * kPaddedBins] += w[6][i];
+    h[(kPaddedCells + 1) * kPaddedBins + 1] += w[7][i];
   }
   // Orientation histograms are circular: fold the spare bins back.
   for (int i = 0; i < kCells; ++i) {
@@ -353,7 +464,8 @@ int DepthSiftDescriber::Describe(const DepthImage& image, std::vector<uint8_t>* 
   const bool up_axis = options_.orientation == ImageOrientation::kUpAxis;
   angles_.clear();
   if (!up_axis) {
-    FindDominantOrientations(image, orientation_weight_.data(), 0.8f, &angles_);
+    FindDominantOrientations(
+        image, orientation_weight_.data(), 0.8f, &orientation_magnitude_, &orientation_bin_, &angles_);
     if (options_.max_orientations > 0 &&
         static_cast<int>(angles_.size()) > options_.max_orientations) {
       angles_.resize(options_.max_orientations);

@@ -114,34 +114,40 @@ class DepthSiftDescriber {
   int Describe(const DepthImage& image, std::vector<uint8_t>* out);
 
  private:
-  // One gradient sample of the blurred image inside the descriptor window:
-  // offset from the centre (row down, column right), orientation in degrees
-  // (y up) and magnitude times the window's Gaussian weight (which depends on
-  // the distance only, so on no orientation).
-  struct Sample {
-    float row, col;
-    float orientation;
-    float weighted_magnitude;
-  };
-
   // (Re)builds the tables that depend on the image size only.
   void Prepare(int size);
   // Grey levels of `image`, blurred, into blurred_, and their gradient
-  // samples into samples_.
+  // samples (sample_orientation_, sample_magnitude_).
   void ComputeSamples(const DepthImage& image);
-  // OpenCV's calcSIFTDescriptor on samples_ for orientation `degrees`,
+  // Each sample's histogram offset and trilinear weights for orientation
+  // `degrees` (sample_offset_, sample_weights_).
+  void BinSamples(float degrees);
+  // OpenCV's calcSIFTDescriptor on the samples for orientation `degrees`,
   // including its normalisation: 128 values in 0..255 (integers) into `bins`.
-  void DescribeAt(float degrees, float* bins) const;
+  void DescribeAt(float degrees, float* bins);
 
   SiftDescriptorOptions options_;
   int size_ = 0;
+  int stride_ = 0;  // floats per row of the working images
   int blur_radius_ = 0;
   std::vector<float> kernel_;              // 2 blur_radius_ + 1 taps
+  std::vector<const float*> tap_rows_;     // the blur's input row of each tap
   std::vector<int> border_;                // padded column -> reflected column
   std::vector<float> window_weight_;       // Gaussian of the descriptor window
   std::vector<float> orientation_weight_;  // DominantOrientations' Gaussian
   std::vector<float> gray_, padded_, rows_, blurred_;
-  std::vector<Sample> samples_;
+  // The gradient samples of the blurred image inside the descriptor window,
+  // one per interior pixel, row by row, as arrays (so that the loops over
+  // them vectorise): offset from the centre (row down, column right),
+  // orientation in degrees (y up), magnitude times the window's Gaussian
+  // weight; then, per orientation described, each one's histogram offset
+  // and its eight trilinear weights.
+  std::vector<float> sample_row_, sample_col_, sample_orientation_, sample_magnitude_;
+  std::vector<int> sample_offset_;
+  std::vector<float> sample_weights_[8];
+  // DominantOrientations' per-pixel scratch.
+  std::vector<float> orientation_magnitude_;
+  std::vector<int> orientation_bin_;
   std::vector<float> angles_;
 };
 
