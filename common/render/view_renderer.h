@@ -90,8 +90,9 @@ class ViewRenderer {
 
   ViewRenderOptions options_;
   Sphere sphere_;
-  // Vertices in the unit enclosing sphere's coordinates.
-  std::vector<Vec3d> vertices_;
+  // Vertices in the unit enclosing sphere's coordinates, one array per axis
+  // (the projection runs over them in vectors).
+  std::vector<double> x_, y_, z_;
   std::vector<Triangle> triangles_;
 };
 
