@@ -75,8 +75,9 @@ int Reflect101(int p, int n) {
 constexpr int kOrientationHistogramBins = 36;
 
 // Gradient magnitude and orientation-histogram bin of every interior pixel of
-// `image` (row-major, image-sized; border entries untouched): the vectorisable
-// half of FindDominantOrientations, compiled wider like ComputeSamples.
+// `image` (row-major, image-sized; what the border columns get is never
+// read): the vectorisable half of FindDominantOrientations, compiled wider
+// like ComputeSamples.
 MESHSEEK_TARGET_CLONES_AVX void OrientationGradients(const DepthImage& image,
                                                      float* __restrict magnitude,
                                                      int* __restrict bin) {

@@ -31,7 +31,9 @@ TEST(PipelineParamsTest, EveryMethodIsRegisteredOnceWithValidDefaults) {
   // BF-DSIFT's codebook, measured (bench/results/bfdsift.txt).
   const RetrievalPipelineOptions bf = RetrievalPipelineOptions::ForMethod(FeatureMethod::kBfDsift);
   EXPECT_EQ(bf.kmeans.num_centroids, 40000);
-  EXPECT_EQ(bf.kmeans.max_points_per_centroid, 50);
+  EXPECT_EQ(bf.kmeans.max_points_per_centroid, 40);
+  EXPECT_EQ(bf.kmeans.max_iterations, 6);
+  EXPECT_EQ(RetrievalPipelineOptions::ForMethod(FeatureMethod::kDldSift).kmeans.max_iterations, 25);
 }
 
 TEST(PipelineParamsTest, NamesAreUniqueAndEveryDefaultLiesInItsOwnRange) {

@@ -36,6 +36,7 @@ RetrievalPipelineOptions::RetrievalPipelineOptions() {
   // have their own measured figures (FeatureMethodInfo).
   kmeans.num_centroids = FeatureMethodInfoOf(extractor.method).vocabulary;
   kmeans.max_points_per_centroid = FeatureMethodInfoOf(extractor.method).kmeans_points_per_centroid;
+  kmeans.max_iterations = FeatureMethodInfoOf(extractor.method).kmeans_iterations;
 }
 
 RetrievalPipelineOptions RetrievalPipelineOptions::ForMethod(FeatureMethod method) {
@@ -45,6 +46,7 @@ RetrievalPipelineOptions RetrievalPipelineOptions::ForMethod(FeatureMethod metho
   if (FeatureMethodInfoOf(method).vocabulary > 0) {
     options.kmeans.num_centroids = FeatureMethodInfoOf(method).vocabulary;
     options.kmeans.max_points_per_centroid = FeatureMethodInfoOf(method).kmeans_points_per_centroid;
+    options.kmeans.max_iterations = FeatureMethodInfoOf(method).kmeans_iterations;
     options.weighting.power = FeatureMethodInfoOf(method).histogram_power;
   }
   return options;
