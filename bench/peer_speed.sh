@@ -13,13 +13,18 @@ cd "$(dirname "$0")/.."
 DATA=${1:-$HOME/.cache/meshseek-data}
 ROUNDS=${2:-2}
 MANIFEST=$DATA/msb_articulated/manifest.csv
-PEER=../shared/peers/fpfh_bof/run.py
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
+# The peer finds the evaluator at ../../shared/tools from its own folder: run
+# a copy from a layout where that resolves.
+mkdir -p "$WORK/root/peers"
+cp -r ../shared/peers/fpfh_bof "$WORK/root/peers/"
+ln -s "$(cd ../shared && pwd)" "$WORK/root/shared"
+PEER=$WORK/root/peers/fpfh_bof/run.py
 seconds() { local s; s=$(date +%s.%N); "$@" >"$WORK/log" 2>&1 || { cat "$WORK/log"; return 1; }; echo "$(date +%s.%N) - $s" | bc; }
 echo "machine: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores; $(date -u '+%F %H:%M UTC')"
 echo "meshseek: build/cli/meshseek eval --progress=false --manifest $MANIFEST --method dld --out <dir> --data_dir <fresh>"
-echo "peer: PEER_OUT=<fresh> /usr/bin/python3 $PEER full --set msb --manifest $MANIFEST --no-cache"
+echo "peer: PEER_OUT=<fresh> /usr/bin/python3 ../shared/peers/fpfh_bof/run.py full --set msb --manifest $MANIFEST --no-cache"
 ours=() theirs=()
 for r in $(seq "$ROUNDS"); do
   rm -rf "$WORK/data" "$WORK/out" "$WORK/peer"
