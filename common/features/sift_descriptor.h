@@ -137,7 +137,8 @@ class DepthSiftDescriber {
   std::vector<float> orientation_weight_;  // DominantOrientations' Gaussian
   std::vector<float> gray_, padded_, rows_, blurred_;
   // The gradient samples of the blurred image inside the descriptor window,
-  // one per interior pixel, row by row, as arrays (so that the loops over
+  // one per pixel of rows 1 .. size - 2 with the row padding (weight 0 off
+  // the interior), row by row, as arrays (so that the loops over
   // them vectorise): offset from the centre (row down, column right),
   // orientation in degrees (y up), magnitude times the window's Gaussian
   // weight; then, per orientation described, each one's histogram offset

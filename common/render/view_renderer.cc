@@ -1,7 +1,5 @@
 #include "common/render/view_renderer.h"
 
-#include "common/base/cpu_features.h"
-
 #include <algorithm>
 #include <cmath>
 
