@@ -19,12 +19,15 @@ MODELS=${3:-$HOME/.cache/meshseek-data/msb_articulated/models}
 MAX=${4:-50}
 METHODS=${5:-bfdsift rld lsf lfd}
 ROUNDS=${6:-2}
+ERR=$(mktemp)
+trap 'rm -f "$ERR"' EXIT
 run() {  # binary method -> "cpu_median_ms fingerprint"
   "$1" --models_dir="$MODELS" --max_models="$MAX" --benchmark_filter="^BM_Extract/$2/" \
-    --benchmark_format=json 2>/tmp/extract_ab.err |
+    --benchmark_format=json 2>"$ERR" |
     python3 -c 'import json,sys; b=json.load(sys.stdin)["benchmarks"][0]; print("%.1f" % b["median_cpu_ms_per_model"])'
-  sed -n 's/.*features fingerprint //p' /tmp/extract_ab.err
+  sed -n 's/.*features fingerprint //p' "$ERR"
 }
+median() { printf '%s\n' "$@" | sort -n | awk '{a[NR]=$1} END{print (NR%2)?a[(NR+1)/2]:(a[NR/2]+a[NR/2+1])/2}'; }
 echo "machine: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores; $(date -u '+%Y-%m-%d %H:%M UTC'); load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "models: $MODELS (first $MAX); $ROUNDS rounds, base and new alternated per method"
 for m in $METHODS; do
@@ -36,7 +39,6 @@ for m in $METHODS; do
     n=${out[0]} nf=${out[1]:-none}
     base_ms+=("$b") new_ms+=("$n")
   done
-  median() { printf '%s\n' "$@" | sort -n | awk '{a[NR]=$1} END{print (NR%2)?a[(NR+1)/2]:(a[NR/2]+a[NR/2+1])/2}'; }
   bm=$(median "${base_ms[@]}") nm=$(median "${new_ms[@]}")
   printf '%-8s base %7.1f ms  new %7.1f ms  ratio %.2f  fingerprints %s %s %s\n' "$m" "$bm" "$nm" \
     "$(echo "$nm / $bm" | bc -l)" "$bf" "$nf" "$([ "$bf" = "$nf" ] && echo same || echo DIFFER)"
