@@ -177,21 +177,19 @@ absl::Status BuildRunner::BuildPart(const std::string& job_id,
                        [&](const ExtractedModel& m) { return eligible->count(m.model_id) == 0; }),
         members.end());
   }
-  // Parsed once, for training and encoding; the stored bytes are let go.
-  // Models indexed by an earlier build have had theirs freed: extracted
-  // again from their meshes, on the extract workers.
+  // Read and parsed once, for training and encoding. Models indexed by an
+  // earlier build have had theirs freed: extracted again from their meshes,
+  // on the extract workers.
   std::vector<v1::LocalFeatures> features(members.size());
   std::vector<absl::Status> loaded(members.size());
   ParallelFor(members.size(), options_.max_in_flight, [&](std::size_t i) {
     if (*stop_) return;
-    ExtractedModel& m = members[i];
-    absl::StatusOr<v1::LocalFeatures> got = workers_->FeaturesOf(store_, part, m);
+    absl::StatusOr<v1::LocalFeatures> got = workers_->FeaturesOf(store_, part, members[i]);
     if (got.ok()) {
       features[i] = *std::move(got);
     } else {
       loaded[i] = got.status();
     }
-    std::string().swap(m.features);
   });
   if (*stop_) return absl::CancelledError("stopping");
   for (const absl::Status& s : loaded) MESHSEEK_RETURN_IF_ERROR(s);

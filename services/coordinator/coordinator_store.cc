@@ -6,6 +6,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "common/base/logging.h"
 #include "common/base/status_macros.h"
 #include "services/coordinator/coordinator_schema.h"
 
@@ -34,14 +35,42 @@ absl::StatusOr<std::unique_ptr<CoordinatorStore>> CoordinatorStore::Open(
   std::filesystem::create_directories(data_dir, error);
   MESHSEEK_ASSIGN_OR_RETURN(std::unique_ptr<Database> db,
                             Database::Open(data_dir + "/coordinator.db"));
-  std::unique_ptr<CoordinatorStore> store(new CoordinatorStore(std::move(db)));
+  MESHSEEK_ASSIGN_OR_RETURN(FeatureFiles features, FeatureFiles::Open(data_dir + "/features"));
+  std::unique_ptr<CoordinatorStore> store(
+      new CoordinatorStore(std::move(db), std::move(features)));
   absl::MutexLock lock(&store->mutex_);
   MESHSEEK_RETURN_IF_ERROR(store->Migrate(index_shards));
   return store;
 }
 
+// Releases before feature files kept features in models.features: each
+// moves to its file, then the column is emptied and the pages given back.
+// The file is written before the row lets go, so a kill midway loses none.
+absl::Status CoordinatorStore::MoveFeaturesOutOfRows() {
+  MESHSEEK_ASSIGN_OR_RETURN(
+      Statement select,
+      db_->Prepare("SELECT collection, model_id, features FROM models WHERE features IS NOT NULL"));
+  uint64_t moved = 0;
+  while (true) {
+    MESHSEEK_ASSIGN_OR_RETURN(const bool row, select.Step());
+    if (!row) break;
+    MESHSEEK_RETURN_IF_ERROR(
+        features_.Put(select.ColumnText(0), select.ColumnText(1), select.ColumnBlob(2)));
+    ++moved;
+  }
+  select.Reset();
+  if (moved == 0) return absl::OkStatus();
+  MESHSEEK_RETURN_IF_ERROR(
+      db_->Execute("UPDATE models SET features = NULL WHERE features IS NOT NULL"));
+  MESHSEEK_LOG(INFO) << db_->path() << ": features of " << moved << " models moved to "
+                     << features_.dir();
+  // A no-op in files of releases before auto_vacuum, which reuse the pages.
+  return db_->Execute("PRAGMA incremental_vacuum");
+}
+
 absl::Status CoordinatorStore::Migrate(int index_shards) {
   MESHSEEK_RETURN_IF_ERROR(MigrateCoordinatorSchema(db_.get()));
+  MESHSEEK_RETURN_IF_ERROR(MoveFeaturesOutOfRows());
   // Models are placed on index shards by hash modulo their number: another
   // number would look for every model on the wrong shard.
   {

@@ -2,8 +2,7 @@
 // lives here. One SQLite file (coordinator.db) under the data folder holds
 //   collections (name, parameters, current codebook),
 //   models      (mesh, label, ingest ordinal, state, attempts, error,
-//                local features until indexed, the codebook it was indexed
-//                with),
+//                the codebook it was indexed with),
 //   jobs        (ingest and build jobs and their state),
 //   thumbnails  (a PNG per model, under the collection clients name),
 //   rankings    (what the build of a fused or re-ranked collection leaves for
@@ -19,6 +18,8 @@
 // Bounded storage: a model's local features are kept from its extraction
 // until it is indexed (and, in a rescaled collection, ranked), then freed
 // (DropFeatures); a build extracts again what it trains on from the mesh.
+// They are kept beside the database, a file a model (feature_files.h), not
+// in it: freeing megabytes of blobs in SQLite rewrote the file.
 // What stays per model beyond its mesh is its row, thumbnail and, in the
 // index, its histograms (docs/design.md "Bounded storage").
 //
@@ -49,6 +50,7 @@
 #include "absl/time/time.h"
 #include "common/store/sqlite_db.h"
 #include "services/coordinator/coordinator_schema.h"
+#include "services/coordinator/feature_files.h"
 #include "meshseek/v1/coordinator.pb.h"
 #include "meshseek/v1/types.pb.h"
 
@@ -104,7 +106,6 @@ struct ExtractedModel {
   std::string model_id;
   uint64_t ordinal = 0;
   std::string label;
-  std::string features;  // serialized v1::LocalFeatures
   std::string indexed_codebook;
 };
 
@@ -117,7 +118,9 @@ struct RankedModel {
 
 class CoordinatorStore {
  public:
-  /// Opens (creating and migrating) `data_dir`/coordinator.db. The number of
+  /// Opens (creating and migrating) `data_dir`/coordinator.db and the
+  /// features folder `data_dir`/features (moving features that a release
+  /// before files kept in the database there). The number of
   /// index shards is recorded at first use: FailedPrecondition when it
   /// differs later, as models would be looked for on the wrong shards.
   /// Streams do not survive a restart: every job's stream is marked closed
@@ -225,6 +228,9 @@ class CoordinatorStore {
   /// A PENDING model's outcome, each in one transaction with its ingest job
   /// finishing when this was the job's last pending model. false when the
   /// model was no longer PENDING (removed meanwhile): nothing changed.
+  /// MarkExtracted keeps `features` (serialized v1::LocalFeatures) until
+  /// DropFeatures; a failure to write them is logged, not returned (the
+  /// build extracts the model again).
   absl::StatusOr<bool> MarkExtracted(const ModelKey& key,
                                      const std::string& features,
                                      uint32_t feature_count);
@@ -236,7 +242,8 @@ class CoordinatorStore {
                              const std::string& error);
   /// `live`: by live ingest, after the build that trained the codebook.
   absl::Status MarkIndexed(const ModelKey& key, const std::string& codebook_id, bool live = false);
-  /// Deletes the model; its state before, or nullopt when there was none.
+  /// Deletes the model and its features; its state before, or nullopt when
+  /// there was none.
   absl::StatusOr<std::optional<ModelState>> RemoveModel(const ModelKey& key);
 
   /// The mesh (serialized v1::Mesh) a model was ingested with, in any
@@ -267,6 +274,9 @@ class CoordinatorStore {
   absl::Status DropFeatures(const std::vector<std::string>& collections,
                             const std::string& build,
                             const std::string& model_id = "");
+  /// A model's stored features (serialized v1::LocalFeatures); nullopt when
+  /// freed, never stored, or not intact (FeatureFiles::Get).
+  std::optional<std::string> LoadFeatures(const ModelKey& key) const;
   /// One EXTRACTED model; nullopt when it is not (or no longer) extracted.
   absl::StatusOr<std::optional<ExtractedModel>> LoadExtracted(const ModelKey& key);
   /// A page of the collection's models (see ListCollectionModelsRequest):
@@ -277,8 +287,10 @@ class CoordinatorStore {
       const v1::ListCollectionModelsRequest& request, const std::vector<std::string>& members = {});
 
  private:
-  explicit CoordinatorStore(std::unique_ptr<Database> db) : db_(std::move(db)) {}
+  CoordinatorStore(std::unique_ptr<Database> db, FeatureFiles features)
+      : features_(std::move(features)), db_(std::move(db)) {}
   absl::Status Migrate(int index_shards) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  absl::Status MoveFeaturesOutOfRows() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   absl::Status FinishIngestJobIfDone(const std::string& job_id)
       ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   absl::StatusOr<std::optional<std::string>> MeshInRows(const ModelKey& key)
@@ -287,9 +299,10 @@ class CoordinatorStore {
                                   ModelState state,
                                   int attempts,
                                   const std::string& error,
-                                  const std::string& features,
+                                  const std::string* features,  // null: none to keep
                                   uint32_t feature_count);
 
+  const FeatureFiles features_;  // thread-safe: needs no lock
   absl::Mutex mutex_;
   std::unique_ptr<Database> db_ ABSL_GUARDED_BY(mutex_);
 };

@@ -5,6 +5,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "common/base/logging.h"
 #include "common/base/status_macros.h"
 #include "services/coordinator/coordinator_schema.h"
 #include "services/coordinator/coordinator_store.h"
@@ -158,42 +159,53 @@ uint64_t CoordinatorStore::PendingCount() {
 absl::StatusOr<bool> CoordinatorStore::MarkExtracted(const ModelKey& key,
                                                      const std::string& features,
                                                      uint32_t feature_count) {
-  return EndPending(key, ModelState::kExtracted, -1, "", features, feature_count);
+  return EndPending(key, ModelState::kExtracted, -1, "", &features, feature_count);
 }
 
 absl::StatusOr<bool> CoordinatorStore::MarkFailed(const ModelKey& key,
                                                   int attempts,
                                                   const std::string& reason) {
-  return EndPending(key, ModelState::kFailed, attempts, reason, "", 0);
+  return EndPending(key, ModelState::kFailed, attempts, reason, nullptr, 0);
 }
 
 absl::StatusOr<bool> CoordinatorStore::EndPending(const ModelKey& key,
                                                   ModelState state,
                                                   int attempts,
                                                   const std::string& error,
-                                                  const std::string& features,
+                                                  const std::string* features,
                                                   uint32_t feature_count) {
   absl::MutexLock lock(&mutex_);
   MESHSEEK_ASSIGN_OR_RETURN(Transaction transaction, Transaction::Begin(db_.get()));
   MESHSEEK_ASSIGN_OR_RETURN(
       Statement update,
-      db_->Prepare("UPDATE models SET state = ?, error = ?, features = ?, feature_count = ?, "
+      db_->Prepare("UPDATE models SET state = ?, error = ?, feature_count = ?, "
                    "attempts = CASE WHEN ? < 0 THEN attempts + 1 ELSE ? END, retry_at = 0 "
                    "WHERE collection = ? AND model_id = ? AND state = 0 RETURNING job_id"));
   update.Bind(1, static_cast<int64_t>(state))
       .Bind(2, error)
-      .BindBlob(3, features)
-      .Bind(4, int64_t{feature_count})
+      .Bind(3, int64_t{feature_count})
+      .Bind(4, int64_t{attempts})
       .Bind(5, int64_t{attempts})
-      .Bind(6, int64_t{attempts})
-      .Bind(7, key.collection)
-      .Bind(8, key.model_id);
+      .Bind(6, key.collection)
+      .Bind(7, key.model_id);
   MESHSEEK_ASSIGN_OR_RETURN(const bool changed, update.Step());
   if (!changed) return false;
   const std::string job_id = update.ColumnText(0);
   update.Reset();
   MESHSEEK_RETURN_IF_ERROR(FinishIngestJobIfDone(job_id));
   MESHSEEK_RETURN_IF_ERROR(transaction.Commit());
+  // The features after the row, under the lock: only the extraction that
+  // ended the model writes them (never a late one of a mesh removed and
+  // ingested again), and a removal waits for it. A kill between the two, or
+  // a write that fails, leaves an extracted model without features: the
+  // build extracts it again, as it does for freed ones.
+  if (features != nullptr) {
+    if (absl::Status put = features_.Put(key.collection, key.model_id, *features); !put.ok()) {
+      features_.Remove(key.collection, key.model_id);
+      MESHSEEK_LOG(WARNING) << "coordinator: model " << key.model_id << " of " << key.collection
+                            << ": features not kept (the build extracts them again): " << put;
+    }
+  }
   return true;
 }
 
@@ -243,21 +255,19 @@ absl::StatusOr<std::optional<ModelState>> CoordinatorStore::RemoveModel(const Mo
   // The removed model may have been the last its ingest job waited for.
   MESHSEEK_RETURN_IF_ERROR(FinishIngestJobIfDone(job_id));
   MESHSEEK_RETURN_IF_ERROR(transaction.Commit());
+  features_.Remove(key.collection, key.model_id);
   return state;
 }
 
 namespace {
 
 constexpr const char* kSelectExtracted =
-    "SELECT model_id, ordinal, label, features, indexed_codebook FROM models "
+    "SELECT model_id, ordinal, label, indexed_codebook FROM models "
     "WHERE collection = ?1 AND state = 1";
 
 ExtractedModel ExtractedRow(const Statement& select) {
-  return {select.ColumnText(0),
-          static_cast<uint64_t>(select.ColumnInt(1)),
-          select.ColumnText(2),
-          select.ColumnBlob(3),
-          select.ColumnText(4)};
+  return {select.ColumnText(0), static_cast<uint64_t>(select.ColumnInt(1)), select.ColumnText(2),
+          select.ColumnText(3)};
 }
 
 }  // namespace
@@ -283,23 +293,33 @@ absl::StatusOr<std::vector<ExtractedModel>> CoordinatorStore::ExtractedModels(
 absl::Status CoordinatorStore::DropFeatures(const std::vector<std::string>& collections,
                                            const std::string& build,
                                            const std::string& model_id) {
-  absl::MutexLock lock(&mutex_);
-  std::string in;
-  for (std::size_t i = 0; i < collections.size(); ++i) absl::StrAppend(&in, ", ?", i + 3);
-  MESHSEEK_ASSIGN_OR_RETURN(
-      Statement drop,
-      db_->Prepare(absl::StrCat("UPDATE models SET features = NULL WHERE collection IN (",
-                                in.substr(2),
-                                ") AND state = 1 AND features IS NOT NULL AND indexed_codebook = "
-                                "collection || '@' || ?1 AND (?2 = '' OR model_id = ?2)")));
-  drop.Bind(1, build).Bind(2, model_id);
-  for (std::size_t i = 0; i < collections.size(); ++i) {
-    drop.Bind(static_cast<int>(i) + 3, collections[i]);
+  std::vector<ModelKey> indexed;
+  {
+    absl::MutexLock lock(&mutex_);
+    std::string in;
+    for (std::size_t i = 0; i < collections.size(); ++i) absl::StrAppend(&in, ", ?", i + 3);
+    MESHSEEK_ASSIGN_OR_RETURN(
+        Statement select,
+        db_->Prepare(absl::StrCat("SELECT collection, model_id FROM models WHERE collection IN (",
+                                  in.substr(2),
+                                  ") AND state = 1 AND indexed_codebook = collection || '@' || ?1 "
+                                  "AND (?2 = '' OR model_id = ?2)")));
+    select.Bind(1, build).Bind(2, model_id);
+    for (std::size_t i = 0; i < collections.size(); ++i) {
+      select.Bind(static_cast<int>(i) + 3, collections[i]);
+    }
+    while (true) {
+      MESHSEEK_ASSIGN_OR_RETURN(const bool row, select.Step());
+      if (!row) break;
+      indexed.push_back({select.ColumnText(0), select.ColumnText(1)});
+    }
   }
-  MESHSEEK_RETURN_IF_ERROR(drop.Run());
-  // The freed pages back to the file system (a no-op in files of releases
-  // before auto_vacuum, which reuse them).
-  return db_->Execute("PRAGMA incremental_vacuum");
+  for (const ModelKey& key : indexed) features_.Remove(key.collection, key.model_id);
+  return absl::OkStatus();
+}
+
+std::optional<std::string> CoordinatorStore::LoadFeatures(const ModelKey& key) const {
+  return features_.Get(key.collection, key.model_id);
 }
 
 absl::StatusOr<std::optional<ExtractedModel>> CoordinatorStore::LoadExtracted(

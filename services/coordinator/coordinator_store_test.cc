@@ -84,6 +84,36 @@ TEST_F(CoordinatorStoreTest, SameModelAgainIsAcknowledgedAnotherIsRefused) {
             absl::StatusCode::kAlreadyExists);
 }
 
+// Features live from the extraction that ends a model until DropFeatures
+// (or its removal); a late extraction of a model no longer pending writes
+// none.
+TEST_F(CoordinatorStoreTest, KeepsFeaturesFromExtractionUntilIndexed) {
+  auto store = OpenStore();
+  ASSERT_TRUE(store->CreateCollections({{"c", Params()}}).ok());
+  const std::string job = store->NewJob("ingest", "c", 0).value();
+  for (const char* id : {"a", "b", "r"}) ASSERT_TRUE(store->AddModel({"c"}, id, "", id, job).ok());
+  EXPECT_EQ(store->LoadFeatures({"c", "a"}), std::nullopt);  // pending: none yet
+  ASSERT_TRUE(store->MarkExtracted({"c", "a"}, "features of a", 1).value());
+  ASSERT_TRUE(store->MarkExtracted({"c", "b"}, "features of b", 1).value());
+  EXPECT_FALSE(store->MarkExtracted({"c", "a"}, "a late copy", 1).value());
+  EXPECT_EQ(store->LoadFeatures({"c", "a"}), "features of a");
+  ASSERT_TRUE(store->RemoveModel({"c", "r"}).ok());
+  EXPECT_FALSE(store->MarkExtracted({"c", "r"}, "of a removed model", 1).value());
+  EXPECT_EQ(store->LoadFeatures({"c", "r"}), std::nullopt);
+  // Only models indexed by the build lose theirs.
+  ASSERT_TRUE(store->MarkIndexed({"c", "a"}, "c@build-2").ok());
+  ASSERT_TRUE(store->DropFeatures({"c"}, "build-2").ok());
+  EXPECT_EQ(store->LoadFeatures({"c", "a"}), std::nullopt);
+  EXPECT_EQ(store->LoadFeatures({"c", "b"}), "features of b");
+  ASSERT_TRUE(store->RemoveModel({"c", "b"}).ok());
+  EXPECT_EQ(store->LoadFeatures({"c", "b"}), std::nullopt);
+  std::size_t files = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir_ / "features")) {
+    files += entry.is_regular_file();
+  }
+  EXPECT_EQ(files, 0u);
+}
+
 TEST_F(CoordinatorStoreTest, IngestJobFinishesWhenItsLastModelEndsNotWhenRead) {
   auto store = OpenStore();
   ASSERT_TRUE(store->CreateCollections({{"c", Params()}}).ok());
@@ -203,13 +233,22 @@ TEST_F(CoordinatorStoreTest, FirstReleaseDatabaseIsMigrated) {
     ASSERT_TRUE(collection->BindBlob(1, params).Run().ok());
     auto model = (*db)->Prepare(
         "INSERT INTO models (collection, model_id, ordinal, label, mesh, fingerprint, state, "
-        "feature_count, job_id) VALUES ('c', 'm', 0, 'cat', ?, ?, 1, 12, 'ingest-1')");
+        "feature_count, job_id, features) VALUES ('c', 'm', 0, 'cat', ?, ?, 1, 12, 'ingest-1', "
+        "'stored features')");
     const std::string legacy =
         absl::StrCat(absl::Hex(Fnv1a64(mesh, kLegacyFnv1a64OffsetBasis), absl::kZeroPad16));
     ASSERT_TRUE(model->BindBlob(1, mesh).Bind(2, legacy).Run().ok());
   }
   auto store = OpenStore();
   ASSERT_NE(store, nullptr);
+  // Features kept in the row by releases before feature files: in a file now.
+  EXPECT_EQ(store->LoadFeatures({"c", "m"}), "stored features");
+  {
+    auto db = Database::Open((dir_ / "coordinator.db").string());
+    auto in_rows = (*db)->Prepare("SELECT COUNT(*) FROM models WHERE features IS NOT NULL");
+    ASSERT_TRUE(in_rows.ok() && in_rows->Run().ok());
+    EXPECT_EQ(in_rows->ColumnInt(0), 0);
+  }
   auto again = store->AddModel({"c"}, "m", "cat", mesh, "ingest-2");
   ASSERT_TRUE(again.ok()) << again.status();
   EXPECT_FALSE(again->created);

@@ -185,12 +185,11 @@ absl::Status Workers::AddToIndex(const std::string& collection,
 absl::StatusOr<v1::LocalFeatures> Workers::FeaturesOf(CoordinatorStore* store,
                                                      const CollectionInfo& part,
                                                      const ExtractedModel& model) {
+  // Intact stored features that do not parse are of a release we do not
+  // know: extracted again like freed ones.
   v1::LocalFeatures features;
-  if (!model.features.empty()) {
-    if (!features.ParseFromString(model.features)) {
-      return absl::DataLossError(
-          absl::StrCat("model ", model.model_id, ": stored features do not parse"));
-    }
+  if (const std::optional<std::string> stored = store->LoadFeatures({part.name, model.model_id});
+      stored.has_value() && features.ParseFromString(*stored)) {
     return features;
   }
   MESHSEEK_ASSIGN_OR_RETURN(const std::optional<std::string> stored,
