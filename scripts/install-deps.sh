@@ -14,6 +14,7 @@ PACKAGES=(
   libflann-dev liblz4-dev                            # k-nearest-neighbour graph (RLD-SIFT)
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # services
   libsqlite3-dev                                     # state of the stateful services
+  zlib1g-dev                                         # CRC-32 of the coordinator's feature files
   prometheus-cpp-dev                                 # the services' Prometheus metrics (/metrics over HTTP)
   libcpp-httplib-dev                                 # the web gateway's HTTP server (meshseek web)
 )

@@ -142,6 +142,13 @@ void Dispatcher::Process(const ModelKey& key) {
   }
   if (*stop_ && !features.ok()) return;  // cut short by the shutdown: not the model's fault
   if (features.ok()) {
+    // What reads them (training, encoding) needs the descriptors only: the
+    // keypoints, a quarter of BF-DSIFT's bytes, are not kept.
+    features->clear_positions();
+    features->clear_views();
+    features->clear_ups();
+    features->clear_scales();
+    features->clear_levels();
     absl::StatusOr<bool> changed =
         store_->MarkExtracted(key, features->SerializeAsString(), features->count());
     if (!changed.ok()) {

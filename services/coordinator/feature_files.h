@@ -24,7 +24,7 @@
 // "<collection>\0<model_id>" and hh its first two (256 folders, so that a
 // folder holds at most a few thousand files at 100,000 models a member). A
 // file is
-//   "MSF1" | u32 key length | u64 payload length | u64 FNV-1a 64 of key and
+//   "MSF1" | u32 key length | u64 payload length | u32 CRC-32 of key and
 //   payload | key | payload (serialized v1::LocalFeatures)
 // with integers little-endian.
 //
