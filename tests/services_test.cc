@@ -664,7 +664,8 @@ TEST_F(ServicesTest, AGlobalDescriptorCollectionSurvivesKillsAndEqualsInProcess)
   }
 }
 
-// A fused, re-ranked collection (LSF + LFD, small settings): each model
+// A fused, re-ranked collection (LSF + LFD, small settings, LSF's codebook
+// trained on a sample of its features): each model
 // stored in both members, each extracted with its method, the build builds
 // both and the ranking state; over two shards, with the coordinator killed
 // during the build, Evaluate gives the in-process matrix bit for bit. A
@@ -675,6 +676,9 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
            {"method", "lsf+lfd"},
            {"points", "128"},
            {"vocabulary", "64"},
+           // 2,560 of LSF's ~6,000 features train: the build sends the codebook
+           // service that sample only (KMeansOptions::sampled_from).
+           {"kmeans_points_per_centroid", "40"},
            {"view_size", "64"},
            {"histogram_power", "0.5"},  // LSF's histograms square-rooted, in the coordinator
            {"rerank_k1", "5"},

@@ -196,7 +196,18 @@ absl::StatusOr<std::vector<float>> TrainKMeansImpl(const T* points,
   std::vector<T> sampled;
   const T* train = points;
   std::size_t n_train = n;
-  if (n > max_train) {
+  if (options.sampled_from > 0) {
+    // The caller sent the sample (KMeansTrainingRows): draw what drawing it
+    // drew, so that seeding goes on from the same generator state.
+    if (options.sampled_from <= max_train || n != max_train) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "k-means: ", n, " points sampled from ", options.sampled_from, "; a sample of ",
+          options.sampled_from, " has ", std::min<std::size_t>(options.sampled_from, max_train),
+          options.sampled_from <= max_train ? " points and is the whole set" : " points"));
+    }
+    rep.input_points = options.sampled_from;
+    SampleIndices(options.sampled_from, max_train, rng);
+  } else if (n > max_train) {
     const std::vector<std::size_t> rows = SampleIndices(n, max_train, rng);
     sampled.resize(max_train * dim);
     for (std::size_t i = 0; i < max_train; ++i) {
@@ -304,7 +315,8 @@ absl::StatusOr<std::vector<float>> TrainKMeansImpl(const T* points,
     labels.resize(n_train);
   }
   if (log_summary) {
-    MESHSEEK_LOG(INFO) << "k-means: " << k << " centroids from " << n_train << " of " << n
+    MESHSEEK_LOG(INFO) << "k-means: " << k << " centroids from " << n_train << " of "
+                       << rep.input_points
                        << " points, " << rep.iterations << " iterations"
                        << (rep.converged ? " (converged)" : "") << ", "
                        << (rep.approximate_assignment
@@ -423,6 +435,18 @@ absl::StatusOr<KMeansOptions::Assignment> ParseKMeansAssignment(absl::string_vie
   if (name == "approximate") return KMeansOptions::Assignment::kApproximate;
   return absl::InvalidArgumentError(absl::StrCat(
       "k-means assignment must be 'auto', 'exact' or 'approximate', got '", name, "'"));
+}
+
+std::vector<std::size_t> KMeansTrainingRows(std::size_t n, const KMeansOptions& options) {
+  const std::size_t max_train = static_cast<std::size_t>(options.num_centroids) *
+                                static_cast<std::size_t>(options.max_points_per_centroid);
+  if (n <= max_train) {
+    std::vector<std::size_t> all(n);
+    for (std::size_t i = 0; i < n; ++i) all[i] = i;
+    return all;
+  }
+  Rng rng(options.seed);
+  return SampleIndices(n, max_train, rng);
 }
 
 absl::StatusOr<std::vector<float>> TrainKMeans(const float* points,

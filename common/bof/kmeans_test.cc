@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -305,6 +306,50 @@ TEST(TrainKMeansTest, SubSamplesAndReports) {
   EXPECT_EQ(report.training_points, 250u);
   EXPECT_EQ(report.init_points, 20u);
   EXPECT_EQ(report.objective.size(), static_cast<std::size_t>(report.iterations));
+}
+
+// A client that sends only KMeansTrainingRows' sample, with sampled_from,
+// gets the centroids of the whole set, bit for bit (uint8 points, as the
+// codebook service trains them; both seedings).
+TEST(TrainKMeansTest, TheSampleAloneGivesTheWholeSetsCentroids) {
+  const Blobs blobs = MakeBlobs(6, 500, 8, 5);
+  const std::size_t n = 3000, dim = 8;
+  std::vector<uint8_t> points(n * dim);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    points[i] = static_cast<uint8_t>(std::clamp(blobs.points[i] + 128.0f, 0.0f, 255.0f));
+  }
+  for (const auto seeding :
+       {KMeansOptions::Seeding::kKMeansPlusPlus, KMeansOptions::Seeding::kRandomDistinct}) {
+    KMeansOptions options = SmallOptions(6);
+    options.max_points_per_centroid = 60;
+    options.seeding = seeding;
+    const std::vector<std::size_t> rows = KMeansTrainingRows(n, options);
+    ASSERT_EQ(rows.size(), 360u);
+    ASSERT_TRUE(std::is_sorted(rows.begin(), rows.end()));
+    std::vector<uint8_t> sample;
+    for (std::size_t r : rows) {
+      sample.insert(sample.end(), points.begin() + r * dim, points.begin() + (r + 1) * dim);
+    }
+    KMeansReport whole_report, sample_report;
+    const auto whole = TrainKMeans(points.data(), n, dim, options, &whole_report);
+    KMeansOptions sampled = options;
+    sampled.sampled_from = n;
+    const auto from_sample = TrainKMeans(sample.data(), rows.size(), dim, sampled, &sample_report);
+    ASSERT_TRUE(whole.ok() && from_sample.ok()) << from_sample.status();
+    EXPECT_EQ(*whole, *from_sample);
+    EXPECT_EQ(sample_report.input_points, n);
+    EXPECT_EQ(sample_report.objective, whole_report.objective);
+    // A "sample" of the wrong size, or of a set that needs none, is refused.
+    EXPECT_EQ(TrainKMeans(sample.data(), rows.size() - 1, dim, sampled).status().code(),
+              absl::StatusCode::kInvalidArgument);
+    sampled.sampled_from = rows.size();
+    EXPECT_EQ(TrainKMeans(sample.data(), rows.size(), dim, sampled).status().code(),
+              absl::StatusCode::kInvalidArgument);
+  }
+  // A set no larger than the sample is all of it.
+  KMeansOptions options = SmallOptions(6);
+  options.max_points_per_centroid = 60;
+  EXPECT_EQ(KMeansTrainingRows(300, options).size(), 300u);
 }
 
 KMeansOptions ApproximateOptions(int k) {

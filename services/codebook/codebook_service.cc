@@ -111,6 +111,7 @@ grpc::Status CodebookService::Train(grpc::ServerContext* context,
   }
   KMeansOptions kmeans = params->kmeans;
   kmeans.num_threads = options_.num_threads;
+  kmeans.sampled_from = first.sampled_from();
   const std::size_t count = descriptors.size() / dim;
   absl::StatusOr<Codebook> codebook = Codebook::Train(
       reinterpret_cast<const uint8_t*>(descriptors.data()), count, dim, kmeans);
@@ -118,7 +119,9 @@ grpc::Status CodebookService::Train(grpc::ServerContext* context,
     return rpc::ToGrpcStatus(absl::Status(
         codebook.status().code(), absl::StrCat("train ", id, ": ", codebook.status().message())));
   }
-  Entry entry{std::make_shared<const Codebook>(*std::move(codebook)), count};
+  // What the codebook was trained from: the whole set when a sample was sent.
+  Entry entry{std::make_shared<const Codebook>(*std::move(codebook)),
+              first.sampled_from() > 0 ? first.sampled_from() : count};
   {
     absl::MutexLock lock(&mutex_);
     absl::StatusOr<Statement> insert =
