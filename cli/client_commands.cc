@@ -17,6 +17,7 @@
 #include "absl/time/clock.h"
 #include "cli/commands.h"
 #include "cli/embedded_stack.h"
+#include "cli/output_format.h"
 #include "cli/pipeline_flags.h"
 #include "cli/session.h"
 #include "common/base/hash.h"
@@ -269,6 +270,7 @@ absl::Status RunQuery(const std::string& model_path) {
   const std::string collection = RequireCollection();
   if (collection.empty()) return absl::InvalidArgumentError("query needs --collection NAME");
   if (model_path.empty()) return absl::InvalidArgumentError("query needs a mesh file: meshseek query MODEL");
+  MESHSEEK_ASSIGN_OR_RETURN(const OutputFormat format, OutputFormatFromFlags());
   MESHSEEK_ASSIGN_OR_RETURN(const MeshReadOptions limits, rpc::MeshLimitsFromFlags());
   MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh, ReadMesh(model_path, nullptr, limits));
   MESHSEEK_ASSIGN_OR_RETURN(auto session, Session::Open());
@@ -280,6 +282,10 @@ absl::Status RunQuery(const std::string& model_path) {
   v1::QueryResponse response;
   MESHSEEK_RETURN_IF_ERROR(Call(session->stub(), &v1::Coordinator::Stub::Query, request, &response,
                                 absl::Minutes(5)));
+  if (format == OutputFormat::kJson) {
+    std::printf("%s\n", ProtoToJson(response).c_str());
+    return absl::OkStatus();
+  }
   std::printf("%u features; nearest in '%s':\n", response.query_features(), collection.c_str());
   std::printf("%4s  %-24s %-16s %s\n", "rank", "model", "label", "distance");
   int rank = 0;
@@ -289,19 +295,24 @@ absl::Status RunQuery(const std::string& model_path) {
   return absl::OkStatus();
 }
 
-absl::Status RunStatus() {
-  MESHSEEK_ASSIGN_OR_RETURN(auto session, Session::Open());
-  if (const std::string job = absl::GetFlag(FLAGS_job); !job.empty()) {
-    MESHSEEK_ASSIGN_OR_RETURN(const v1::JobStatus status, WaitForJob(session->stub(), job, job));
-    std::printf("%s\n", status.DebugString().c_str());
-    return absl::OkStatus();
+// Every failed model of `collection` and why, a page at a time.
+absl::StatusOr<std::vector<v1::ModelInfo>> FailedModels(v1::Coordinator::Stub* stub,
+                                                        const std::string& collection) {
+  v1::ListCollectionModelsRequest list;
+  list.set_collection(collection);
+  list.set_state(v1::MODEL_STATE_FAILED);
+  list.set_page_size(1000);
+  std::vector<v1::ModelInfo> failed;
+  while (true) {
+    v1::ListCollectionModelsResponse page;
+    MESHSEEK_RETURN_IF_ERROR(Call(stub, &v1::Coordinator::Stub::ListModels, list, &page));
+    failed.insert(failed.end(), page.models().begin(), page.models().end());
+    if (page.next_page_token().empty()) return failed;
+    list.set_page_token(page.next_page_token());
   }
-  const std::string collection = RequireCollection();
-  if (collection.empty()) return absl::InvalidArgumentError("status needs --collection NAME or --job ID");
-  v1::GetCollectionRequest get;
-  get.set_name(collection);
-  v1::Collection info;
-  MESHSEEK_RETURN_IF_ERROR(Call(session->stub(), &v1::Coordinator::Stub::GetCollection, get, &info));
+}
+
+void PrintStatusText(const v1::Collection& info, const std::vector<v1::ModelInfo>& failed) {
   std::string params;
   for (const v1::ParamValue& v : info.params().values()) {
     absl::StrAppend(&params, params.empty() ? "" : " ", v.name(), "=", v.value());
@@ -319,22 +330,41 @@ absl::Status RunStatus() {
       static_cast<unsigned long long>(info.added_since_build()),
       info.codebook_id().c_str(),
       params.c_str());
-  // Every failed model and why, a page at a time.
-  v1::ListCollectionModelsRequest list;
-  list.set_collection(collection);
-  list.set_state(v1::MODEL_STATE_FAILED);
-  list.set_page_size(1000);
-  if (info.failed() > 0) std::printf("failed models:\n");
-  while (info.failed() > 0) {
-    v1::ListCollectionModelsResponse page;
-    MESHSEEK_RETURN_IF_ERROR(Call(session->stub(), &v1::Coordinator::Stub::ListModels, list, &page));
-    for (const v1::ModelInfo& m : page.models()) {
-      std::printf("  %s (%u attempt%s): %s\n", m.model_id().c_str(), m.attempts(),
-                  m.attempts() == 1 ? "" : "s", m.error().c_str());
-    }
-    if (page.next_page_token().empty()) break;
-    list.set_page_token(page.next_page_token());
+  if (!failed.empty()) std::printf("failed models:\n");
+  for (const v1::ModelInfo& m : failed) {
+    std::printf("  %s (%u attempt%s): %s\n", m.model_id().c_str(), m.attempts(),
+                m.attempts() == 1 ? "" : "s", m.error().c_str());
   }
+}
+
+absl::Status RunStatus() {
+  MESHSEEK_ASSIGN_OR_RETURN(const OutputFormat format, OutputFormatFromFlags());
+  MESHSEEK_ASSIGN_OR_RETURN(auto session, Session::Open());
+  if (const std::string job = absl::GetFlag(FLAGS_job); !job.empty()) {
+    MESHSEEK_ASSIGN_OR_RETURN(const v1::JobStatus status, WaitForJob(session->stub(), job, job));
+    std::printf("%s\n", format == OutputFormat::kJson ? ProtoToJson(status).c_str()
+                                                       : status.DebugString().c_str());
+    return absl::OkStatus();
+  }
+  const std::string collection = RequireCollection();
+  if (collection.empty()) return absl::InvalidArgumentError("status needs --collection NAME or --job ID");
+  v1::GetCollectionRequest get;
+  get.set_name(collection);
+  v1::Collection info;
+  MESHSEEK_RETURN_IF_ERROR(Call(session->stub(), &v1::Coordinator::Stub::GetCollection, get, &info));
+  std::vector<v1::ModelInfo> failed;
+  if (info.failed() > 0) {
+    MESHSEEK_ASSIGN_OR_RETURN(failed, FailedModels(session->stub(), collection));
+  }
+  if (format == OutputFormat::kText) {
+    PrintStatusText(info, failed);
+    return absl::OkStatus();
+  }
+  // {"collection": Collection, "failed_models": [ModelInfo, ...]}
+  std::string models;
+  for (const v1::ModelInfo& m : failed) absl::StrAppend(&models, models.empty() ? "" : ",", ProtoToJson(m));
+  std::printf("{\"collection\":%s,\"failed_models\":[%s]}\n", ProtoToJson(info).c_str(),
+              models.c_str());
   return absl::OkStatus();
 }
 

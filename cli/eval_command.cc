@@ -6,6 +6,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "cli/commands.h"
+#include "cli/output_format.h"
 #include "cli/pipeline_flags.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
@@ -25,6 +26,7 @@ absl::Status RunEval() {
   if (manifest_path.empty()) return absl::InvalidArgumentError("eval needs --manifest FILE");
   if (out_dir.empty()) return absl::InvalidArgumentError("eval needs --out DIR");
 
+  MESHSEEK_ASSIGN_OR_RETURN(const OutputFormat format, OutputFormatFromFlags());
   MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromFlags());
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<ManifestEntry> models, ReadManifest(manifest_path));
   std::fprintf(stderr,
@@ -38,6 +40,10 @@ absl::Status RunEval() {
                                 ? EvaluateCollection(models, options)
                                 : EvaluateThroughServices(models, options, manifest_path));
   MESHSEEK_RETURN_IF_ERROR(WriteEvaluation(evaluation, options, out_dir));
+  if (format == OutputFormat::kJson) {
+    std::printf("%s\n", EvaluationMetricsJson(evaluation, options).Dump().c_str());
+    return absl::OkStatus();
+  }
 
   const StageTimings& t = evaluation.timings;
   std::printf("%s", FormatMetricsTable(evaluation.metrics).c_str());

@@ -63,6 +63,9 @@ Commands:
          writes DIR/points.ply (feature points coloured by level), DIR/points.png
          (the model with its visible feature points) and DIR/depth_images.png.
 
+status, query and eval take --format json: one JSON document on stdout for
+programs (the proto's field names; eval's is metrics.json).
+
 Run `meshseek --helpfull` for every flag.)";
 
 int Fail(const absl::Status& status) {

@@ -161,6 +161,10 @@ absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
           evaluation.models.size()));
     }
   }
+  return WriteStringToFile(out_dir + "/metrics.json", EvaluationMetricsJson(evaluation, options).Dump());
+}
+
+Json EvaluationMetricsJson(const CollectionEvaluation& evaluation, const CollectionOptions& options) {
   Json report = MetricsToJson(evaluation.metrics);
   report.Set("models", static_cast<int64_t>(evaluation.models.size()));
   report.Set("parameters", options.ToJson());
@@ -189,7 +193,7 @@ absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
     }
   }
   report.Set("timings_seconds", std::move(timings));
-  return WriteStringToFile(out_dir + "/metrics.json", report.Dump());
+  return report;
 }
 
 }  // namespace meshseek

@@ -14,6 +14,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
+#include "common/base/json.h"
 #include "common/eval/manifest.h"
 #include "common/eval/retrieval_metrics.h"
 #include "common/pipeline/collection_options.h"
@@ -63,6 +64,10 @@ absl::StatusOr<CollectionEvaluation> EvaluateCollection(const std::vector<Manife
 absl::Status WriteEvaluation(const CollectionEvaluation& evaluation,
                              const CollectionOptions& options,
                              const std::string& out_dir);
+
+// The document WriteEvaluation writes as metrics.json (and `meshseek eval
+// --format json` prints).
+Json EvaluationMetricsJson(const CollectionEvaluation& evaluation, const CollectionOptions& options);
 
 }  // namespace meshseek
 
