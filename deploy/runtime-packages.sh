@@ -5,7 +5,8 @@
 # the build stage (deploy/Dockerfile) or on this machine
 # (deploy/image-from-build.sh).
 #   deploy/runtime-packages.sh BINARY...
-set -euo pipefail
+# No pipefail: `dpkg -S | head -1` may end dpkg early by SIGPIPE, which is no error.
+set -eu
 for b in "$@"; do readelf -d "$b"; done \
   | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' | sort -u \
   | while read -r lib; do dpkg -S "*/$lib" | head -1 | cut -d: -f1; done \

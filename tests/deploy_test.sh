@@ -93,6 +93,7 @@ collection_counts() {
 c = json.load(sys.stdin)["collection"]
 print(" ".join(f"{k}={int(c[k])}" for k in ("models", "pending", "extracted", "failed", "indexed")))'
 }
+ALL_INDEXED="models=72 pending=0 extracted=72 failed=0 indexed=72"
 
 step "compose up with 1 extract replica"
 $COMPOSE down -v --remove-orphans >/dev/null 2>&1 || true
@@ -127,7 +128,7 @@ sys.exit(0 if all(a[k] == b[k] for k in keys) else 1)
 PY
 counts=$(collection_counts)
 step "status: $counts"
-[ "$counts" = "models=72 pending=0 extracted=72 failed=0 indexed=72" ] \
+[ "$counts" = "$ALL_INDEXED" ] \
   || fail "not every model indexed once: $counts"
 [ "$($COMPOSE ps -q extract 2>/dev/null | wc -l)" -eq 3 ] || fail "expected 3 extract containers"
 
@@ -165,7 +166,7 @@ step "down and up again: the index is still there"
 $COMPOSE down > "$T/compose.log" 2>&1 || { cat "$T/compose.log"; fail "compose down"; }
 $COMPOSE up -d > "$T/compose.log" 2>&1 || { cat "$T/compose.log"; fail "compose up again"; }
 wait_serving
-[ "$(collection_counts)" = "models=72 pending=0 extracted=72 failed=0 indexed=72" ] \
+[ "$(collection_counts)" = "$ALL_INDEXED" ] \
   || fail "index lost after down/up: $(collection_counts)"
 "$BIN" eval --progress=false --server "localhost:$MESHSEEK_PORT" --collection synthetic \
   --manifest "$T/syn/manifest.csv" --out "$T/again" >/dev/null 2>&1 || fail "eval after restart"
