@@ -1,4 +1,4 @@
-// LSF on a labelled collection under the paper's protocol (DESIGN.md 3.3):
+// LSF on a labelled collection under the paper's protocol (docs/design.md 3.3):
 // extract every model (in parallel over models), learn a codebook per
 // vocabulary size from the collection's own features, encode, rank by
 // symmetric KL and print NN / FT / ST / E / DCG, with each model's extraction

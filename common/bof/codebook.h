@@ -1,11 +1,11 @@
-// A visual vocabulary for bag-of-features (DESIGN.md 2.7): V centroids
+// A visual vocabulary for bag-of-features (docs/design.md 2.7): V centroids
 // ("visual words") in descriptor space, learnt by k-means over local features
 // of the collection's own models, and the encoder that turns one model's local
 // descriptors into a normalised histogram of nearest words.
 //
 // Encoding uses the same kind of nearest-centroid search that assigned points
 // during training (KMeansOptions::assignment), with the same parameters:
-//  - exact (nearest_centroid.h; the default up to V = 10,000), about 15 ms for
+//  - exact (nearest_centroid.h; the default below V = 1,000), about 15 ms for
 //    2,048 descriptors against V = 1,000 on one core, identical on every
 //    machine and thread count;
 //  - approximate (approximate_nearest_centroid.h; large vocabularies), the

@@ -1,5 +1,5 @@
 // Symmetric Kullback-Leibler divergence between bag-of-features histograms,
-// the distance of the paper (Ohishi & Ohbuchi 2013, eq. 1; DESIGN.md 2.7):
+// the distance of the paper (Ohishi & Ohbuchi 2013, eq. 1; docs/design.md 2.7):
 //
 //   D(x, y) = sum_k (x_k - y_k) ln(x_k / y_k)  =  KL(x || y) + KL(y || x).
 //
@@ -11,10 +11,10 @@
 //
 // which is (x_k + eps) / (1 + V eps) for a normalised x, and compute D on x' and
 // y'. (FLANN's KL distance instead skips bins that are zero in either vector and
-// is not symmetric; DESIGN.md says not to use it.) With this rule every term
+// is not symmetric, so meshseek does not use it: docs/design.md 2.7.) With this rule every term
 // (x'_k - y'_k)(ln x'_k - ln y'_k) is >= 0, so D >= 0, D(x, x) = 0, and a word
 // used by one model and not by the other costs about a ln(a / epsilon) for its
-// mass a instead of infinity. Epsilon is the knob DESIGN.md 2.8 leaves open:
+// mass a instead of infinity. Epsilon is the knob the paper leaves open (docs/design.md 2.8):
 // smaller weighs "word present in one model only" more against "word used
 // with different frequencies". Default 1e-10, measured on McGill articulated
 // (DLD-SIFT, V = 1,000..3,000): first tier rose monotonically as epsilon fell

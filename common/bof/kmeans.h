@@ -1,5 +1,5 @@
 // Seeded, deterministic k-means (Lloyd) for learning a visual vocabulary
-// (DESIGN.md 2.7: the codebook is k-means over local features sampled from the
+// (docs/design.md 2.7: the codebook is k-means over local features sampled from the
 // collection's own models).
 //
 // Steps:
@@ -75,7 +75,7 @@ struct KMeansOptions {
     kRandomDistinct,
   };
 
-  /// Number of centroids k, i.e. the vocabulary size V (DESIGN.md 2.7: 500..5,000).
+  /// Number of centroids k, i.e. the vocabulary size V (docs/design.md 2.7: 500..5,000).
   int num_centroids = 1000;
   /// Maximum number of Lloyd iterations (one assignment and one update each).
   /// Faiss's default. One iteration over 100,000 x 128 points with V = 1,000

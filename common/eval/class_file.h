@@ -1,4 +1,4 @@
-// Princeton Shape Benchmark class files ("PSB 1" format, DESIGN.md 3.1), the
+// Princeton Shape Benchmark class files ("PSB 1" format, docs/design.md 3.1), the
 // ground truth that the PSB tools and tools/psb_eval.py read:
 //
 //   PSB 1

@@ -1,5 +1,5 @@
 // Distance matrices in the Princeton Shape Benchmark's binary format
-// (DESIGN.md 3.1): N x N little-endian float32, row-major, entry i*N+j = the
+// (docs/design.md 3.1): N x N little-endian float32, row-major, entry i*N+j = the
 // distance from model i (the query) to model j, smaller meaning more similar,
 // in class-file / manifest order. No header: N comes from the class file.
 // Emitting exactly this lets anyone's evaluator (psbTable, tools/psb_eval.py)

@@ -1,5 +1,5 @@
 // The evaluation report: what `meshseek eval` left in its folder, turned into
-// the figures a person reads (DESIGN.md 3): the metrics, first tier per class,
+// the figures a person reads (docs/design.md 3): the metrics, first tier per class,
 // precision-recall curves, and a few queries' top results as pictures.
 //
 // Reading (ReadEvaluationRun) and computing (ComputeEvaluationReport) are

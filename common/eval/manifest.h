@@ -1,5 +1,5 @@
 // Data-set manifests: the CSV list of models (id, class, mesh file) that every
-// meshseek data set in data/ carries (DESIGN.md 3.1).
+// meshseek data set in data/ carries (docs/design.md 3.1).
 //
 //   id,class,path
 //   m1298,F117,db/12/m1298/m1298.off

@@ -1,5 +1,5 @@
 // Precision-recall curves of leave-one-out retrieval, under the same protocol
-// as retrieval_metrics.h (DESIGN.md 3.2): every model of a class with C >= 3
+// as retrieval_metrics.h (docs/design.md 3.2): every model of a class with C >= 3
 // models that is not misc ("-1") is a query; its ranking is the other N-1
 // models by ascending distance, ties broken by lower index; the relevant
 // models are the k = C-1 others of its class.

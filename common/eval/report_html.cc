@@ -413,7 +413,7 @@ absl::StatusOr<std::string> EvaluationReportHtml(const EvaluationReport& report)
                   "<footer>Written by <code>meshseek report</code> from ",
                   "<code>models.csv</code>, <code>distances.bin</code> and "
                   "<code>metrics.json</code>; the metrics are recomputed from the distances "
-                  "and agree with metrics.json. Protocol: DESIGN.md section 3.</footer>"
+                  "and agree with metrics.json. Protocol: meshseek docs/design.md section 3.</footer>"
                   "</main></body></html>\n");
   return html;
 }

@@ -1,5 +1,6 @@
-// Leave-one-out retrieval statistics (DESIGN.md 3.2), defined exactly as the
-// independent reference tools/psb_eval.py computes them, which in turn follow
+// Leave-one-out retrieval statistics (docs/design.md 3.2), defined exactly as the
+// independent reference evaluator psb_eval.py (outside the repository; bench/
+// scripts run it on every matrix) computes them, which in turn follow
 // the Princeton Shape Benchmark's psbTable (Shilane et al., "The Princeton
 // Shape Benchmark", SMI 2004).
 //
@@ -74,7 +75,7 @@ struct ScoreColumn {
 absl::Span<const ScoreColumn> ScoreColumns();
 
 // The classes of a labelled N x N distance matrix and which models are
-// queries (DESIGN.md 3.2: not misc, of a class with more than 2 models):
+// queries (docs/design.md 3.2: not misc, of a class with more than 2 models):
 // what every evaluation of a ranking starts from.
 struct QueryClasses {
   std::vector<std::string> names;    // classes in order of their first model
@@ -107,7 +108,7 @@ absl::StatusOr<RetrievalMetrics> EvaluateRetrieval(const std::vector<std::string
                                                    const std::vector<float>& distances,
                                                    int num_threads = 1);
 
-// The summary as tools/psb_eval.py prints it, in percent with one decimal:
+// The summary as psb_eval.py prints it, in percent with one decimal:
 //
 //   255 queries in 10 classes (percent)
 //                 NN       FT       ST        E      DCG  RP_excl  RP_incl

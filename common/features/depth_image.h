@@ -1,6 +1,6 @@
 // Local depth images: orthographic z-buffer renderings of the surface around a
 // point, the "image" that LD-SIFT and its variants describe with SIFT
-// (Darom & Keller 2012; Ohishi & Ohbuchi 2013, Fig. 2; DESIGN.md 2.2).
+// (Darom & Keller 2012; Ohishi & Ohbuchi 2013, Fig. 2; docs/design.md 2.2).
 //
 // Geometry of a view pair for a point p, support radius s and an orthonormal
 // frame (up u, normal n):

@@ -1,5 +1,5 @@
 // DLD-SIFT: dense local depth SIFT (Ohishi & Ohbuchi 2013, sec. 3.2;
-// DESIGN.md 2.4). No interest-point detection: N_DLD "forced" feature points
+// docs/design.md 2.4). No interest-point detection: N_DLD "forced" feature points
 // are sampled area-uniformly on the surface (SampleSurface), and each gets a
 // pair of local depth images (front and back) described by SIFT.
 //

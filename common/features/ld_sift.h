@@ -1,5 +1,5 @@
 // LD-SIFT, the baseline (Darom & Keller, "Scale-invariant features for 3-D
-// mesh models", TIP 2012; DESIGN.md 2.5): interest points by the scale space
+// mesh models", TIP 2012; docs/design.md 2.5): interest points by the scale space
 // of the mesh's own vertex graph (scale_space.h), described by one depth
 // image each, seen from outside along the vertex normal.
 //

@@ -1,5 +1,5 @@
 // What every LD-SIFT variant does once it has a feature point and its
-// support radius s (DESIGN.md 2.2, 2.3): a local frame from the surface points
+// support radius s (docs/design.md 2.2, 2.3): a local frame from the surface points
 // within s, one or two depth images of the original triangles, and their SIFT
 // descriptors. DLD-SIFT, LD-SIFT and RLD-SIFT differ only in where the points,
 // radii and view directions come from.

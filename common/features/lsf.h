@@ -1,5 +1,5 @@
 // LSF: local statistical features, in the spirit of Ohkita, Ohishi, Furuya &
-// Ohbuchi (ICME workshops 2012; DESIGN.md 2.7b). Each feature is a histogram of
+// Ohbuchi (ICME workshops 2012; docs/design.md 2.7b). Each feature is a histogram of
 // geometric relations among oriented surface samples inside a sphere about a
 // feature centre; bag of features over a k-means codebook and symmetric KL
 // ranking integrate them per model, as for the SIFT methods. The original

@@ -1,4 +1,4 @@
-// RLD-SIFT: resampled LD-SIFT (Ohishi & Ohbuchi 2013, sec. 3.1; DESIGN.md
+// RLD-SIFT: resampled LD-SIFT (Ohishi & Ohbuchi 2013, sec. 3.1; docs/design.md
 // 2.6). The surface is resampled with N_RLD area-uniform Sobol points
 // (SampleSurface), each joined to its k nearest neighbours (symmetrised), and
 // LD-SIFT's scale-space detector runs on that graph, so interest points no

@@ -1,5 +1,5 @@
 // LD-SIFT's interest-point detector on a point graph (Darom & Keller 2012, as
-// their public code does it; DESIGN.md 2.5), used by LD-SIFT on the mesh's own
+// their public code does it; docs/design.md 2.5), used by LD-SIFT on the mesh's own
 // vertex graph and by RLD-SIFT on a k-nearest-neighbour graph of surface
 // samples. Written once for both.
 //

@@ -1,4 +1,4 @@
-// SIFT descriptors of local depth images (DESIGN.md 2.3).
+// SIFT descriptors of local depth images (docs/design.md 2.3).
 //
 // One 128-d descriptor (4 x 4 spatial cells x 8 orientations) centred on the
 // image and covering it, as OpenCV's cv::SIFT computes it for a keypoint of

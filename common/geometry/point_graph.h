@@ -1,5 +1,5 @@
 // Undirected graphs over points, the domain of the LD-SIFT scale space
-// (DESIGN.md 2.5): a mesh's own vertex connectivity for LD-SIFT, a symmetrised
+// (docs/design.md 2.5): a mesh's own vertex connectivity for LD-SIFT, a symmetrised
 // k-nearest-neighbour graph over surface samples for RLD-SIFT.
 #ifndef MESHSEEK_COMMON_GEOMETRY_POINT_GRAPH_H_
 #define MESHSEEK_COMMON_GEOMETRY_POINT_GRAPH_H_

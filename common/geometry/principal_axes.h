@@ -1,5 +1,5 @@
 // Principal component analysis of a small 3-D point set: the local frame of
-// every LD-SIFT-style descriptor (DESIGN.md 2.2, "local tangential plane by
+// every LD-SIFT-style descriptor (docs/design.md 2.2, "local tangential plane by
 // PCA").
 #ifndef MESHSEEK_COMMON_GEOMETRY_PRINCIPAL_AXES_H_
 #define MESHSEEK_COMMON_GEOMETRY_PRINCIPAL_AXES_H_

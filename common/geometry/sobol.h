@@ -4,7 +4,7 @@
 // Dimension 1 uses the primitive polynomial x + 1 with initial direction number
 // m1 = 1; dimension 2 uses x^2 + x + 1 with m = (1, 1); 30 bits, Gray-code
 // order. The first points are (0.5, 0.5), (0.25, 0.75), (0.75, 0.25),
-// (0.375, 0.625), ... (DESIGN.md 2.1). Low discrepancy gives lower variance in
+// (0.375, 0.625), ... (docs/design.md 2.1). Low discrepancy gives lower variance in
 // sample density than pseudo-random numbers, and the sequence is fully
 // deterministic, so resampling a model always gives the same points.
 #ifndef MESHSEEK_COMMON_GEOMETRY_SOBOL_H_

@@ -6,7 +6,7 @@ namespace meshseek {
 namespace {
 
 TEST(Sobol2DTest, MatchesNumericalRecipesTestVectors) {
-  // DESIGN.md 2.1: the first ten points of NR's sobseq in two dimensions.
+  // docs/design.md 2.1: the first ten points of NR's sobseq in two dimensions.
   const double expected[10][2] = {{0.5, 0.5},
                                   {0.25, 0.75},
                                   {0.75, 0.25},

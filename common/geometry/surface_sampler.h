@@ -1,5 +1,5 @@
 // Area-uniform quasi-random sampling of a triangle mesh surface (the seed
-// paper's sec. 3.1; DESIGN.md 2.1). Used for DLD-SIFT feature points, for the
+// paper's sec. 3.1; docs/design.md 2.1). Used for DLD-SIFT feature points, for the
 // dense point set behind local frames, and for RLD-SIFT's remeshing.
 //
 // One point per area A/N: triangles are visited in order and get

@@ -1,5 +1,5 @@
 // Bounding-volume hierarchy over a mesh's triangles, for finding the
-// triangles near a point without looping over the whole mesh (DESIGN.md 2.2:
+// triangles near a point without looping over the whole mesh (docs/design.md 2.2:
 // each depth image rasterises only the triangles inside its view box).
 //
 // Built once per model: median split of triangle centroids along the longest

@@ -1,4 +1,4 @@
-// Evaluating a collection under the paper's protocol (DESIGN.md 3.3): every
+// Evaluating a collection under the paper's protocol (docs/design.md 3.3): every
 // model a query against all others, codebooks learnt from the collection's
 // own features. Each method of the collection is evaluated by
 // EvaluateMethod (retrieval_pipeline.h); their matrices are then combined

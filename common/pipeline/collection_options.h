@@ -1,6 +1,6 @@
 // What a collection is: one or more feature methods, each with its own
 // pipeline (RetrievalPipelineOptions), and how their distances become one
-// ranking (DESIGN.md 2.7, README "Beyond the paper").
+// ranking (docs/design.md 2.7, 2.7c).
 //
 //   one method, no re-ranking   the method's own distance, as the paper ranks
 //                               (symmetric KL of BoF histograms, LFD's own);

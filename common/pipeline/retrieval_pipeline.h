@@ -1,6 +1,6 @@
 // The in-process retrieval pipeline: local features -> visual codebook ->
 // bag-of-features histograms -> symmetric-KL ranking -> metrics, for a labelled
-// collection, under the paper's protocol (DESIGN.md 3.3): every model is a
+// collection, under the paper's protocol (docs/design.md 3.3): every model is a
 // query against all others, and the codebook is learnt from the collection's
 // own local features.
 //

@@ -1,13 +1,13 @@
 // Exact symmetric-KL search over sparse histograms with an inverted file: the
 // index engine of the index service and the ranking of `eval`.
 //
-// The distance is the one of kl_divergence.h (DESIGN.md 2.7): add epsilon to
+// The distance is the one of kl_divergence.h (docs/design.md 2.7): add epsilon to
 // every bin of a histogram x summing to 1, renormalise, x'_k = c (x_k + eps)
 // with c = 1 / (1 + V eps), and
 //
 //   D(x, y) = sum_k (x'_k - y'_k)(ln x'_k - ln y'_k).
 //
-// Derivation (DESIGN.md 2.7a). ln x'_k - ln y'_k = ln((x_k + eps) / (y_k + eps))
+// Derivation (docs/design.md 2.7a). ln x'_k - ln y'_k = ln((x_k + eps) / (y_k + eps))
 // = g(x_k) - g(y_k) with g(t) = ln(1 + t / eps), so g(0) = 0, and
 // x'_k - y'_k = c (x_k - y_k). Hence
 //

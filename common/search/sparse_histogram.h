@@ -1,7 +1,7 @@
 // A bag-of-features histogram stored sparsely: the words a model uses and
 // their weights. Real histograms at V = 2,000 use about half the words and
 // at V = 20,000 a few percent, so the index keeps only these pairs
-// (DESIGN.md 2.7a).
+// (docs/design.md 2.7a).
 #ifndef MESHSEEK_COMMON_SEARCH_SPARSE_HISTOGRAM_H_
 #define MESHSEEK_COMMON_SEARCH_SPARSE_HISTOGRAM_H_
 

@@ -7,7 +7,7 @@
 // non-rigid variation, random rotation, scale and translation and tessellation
 // density, some stored as polygon soups and some as unwelded parts, written in
 // a rotating mix of OFF, OBJ, PLY and STL, ASCII and binary, with a manifest
-// and a PSB class file (DESIGN.md 3.1).
+// and a PSB class file (docs/design.md 3.1).
 //
 // Determinism: the same options give byte-identical files. The random draws
 // are the same on every platform (see SynthRandom); the geometry computed from
