@@ -19,24 +19,21 @@ namespace {
 // its own server thread (a synchronous server has no other place to park a
 // call). The queue's bound is not counted here: gRPC's thread cap
 // (max_running + max_queued + 1) stops calls beyond it before they arrive.
+// Every call waits its turn, even one that arrives with the queue full:
+// gRPC then usually answers it RESOURCE_EXHAUSTED without running its
+// handler, but not always (a thread still sending a finished call's status
+// is counted in the cap while its slot is already free), and letting such a
+// call through at once ran three handlers on a two-slot server (rpc/
+// server_test, once its cases ran one per process). A refusal therefore
+// waits for a slot too, and the running bound always holds.
 class AdmissionGate {
  public:
-  AdmissionGate(int max_running, int max_queued)
-      : max_running_(max_running), max_queued_(max_queued) {}
+  explicit AdmissionGate(int max_running) : max_running_(max_running) {}
 
   void Enter() {
     absl::MutexLock lock(&mutex_);
-    // With the queue full this thread is the one gRPC keeps back for
-    // answering RESOURCE_EXHAUSTED (its handler never runs): let it through
-    // at once instead of making the refusal wait for a slot.
-    if (waiting_ >= max_queued_) {
-      ++running_;
-      return;
-    }
     const Turn turn{this, next_ticket_++};
-    ++waiting_;
     mutex_.Await(absl::Condition(&turn, &Turn::Ready));
-    --waiting_;
     ++next_admitted_;
     ++running_;
   }
@@ -57,10 +54,8 @@ class AdmissionGate {
   };
 
   const int max_running_;
-  const int max_queued_;
   absl::Mutex mutex_;
   int running_ ABSL_GUARDED_BY(mutex_) = 0;
-  int waiting_ ABSL_GUARDED_BY(mutex_) = 0;
   uint64_t next_ticket_ ABSL_GUARDED_BY(mutex_) = 0;
   uint64_t next_admitted_ ABSL_GUARDED_BY(mutex_) = 0;
 };
@@ -203,7 +198,7 @@ absl::StatusOr<std::unique_ptr<RpcServer>> RpcServer::Start(
   std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
   interceptors.push_back(MetricsInterceptorFactory(name));
   interceptors.push_back(std::make_unique<AdmissionInterceptorFactory>(
-      std::make_shared<AdmissionGate>(options.max_threads, options.max_queued_calls)));
+      std::make_shared<AdmissionGate>(options.max_threads)));
   builder.experimental().SetInterceptorCreators(std::move(interceptors));
   builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_MS,
                              static_cast<int>(absl::ToInt64Milliseconds(options.max_connection_age)));

@@ -9,9 +9,9 @@
 //   - bounded concurrency with a bounded queue (admission): at most
 //     `max_threads` unary calls run at once; up to `max_queued_calls` more
 //     wait, first come first served, on a thread of their own; a call beyond
-//     both gets RESOURCE_EXHAUSTED at once (gRPC's "Server Threadpool
-//     Exhausted": the thread cap below is what makes it). A burst of 64 calls
-//     to a 16-thread server is therefore served, not refused;
+//     both gets RESOURCE_EXHAUSTED (gRPC's "Server Threadpool Exhausted": the
+//     thread cap below is what makes it) as soon as a slot frees. A burst of
+//     64 calls to a 16-thread server is therefore served, not refused;
 //   - TLS, mutual TLS and a bearer token (credentials.h, `security`), and an
 //     optional plaintext port that serves only grpc.health.v1, for probes
 //     that cannot speak TLS (kubelet's gRPC probes);
@@ -51,7 +51,8 @@ struct ServerOptions {
   /// Unary calls that wait for a running slot when all are taken. Each holds
   /// a sleeping thread and its received request. gRPC's thread cap is set to
   /// max_threads + max_queued_calls + 2 (its pollers), so the queue is the
-  /// bound: beyond it a call gets RESOURCE_EXHAUSTED immediately.
+  /// bound: beyond it a call gets RESOURCE_EXHAUSTED when a slot frees (the
+  /// refusal waits its turn, so that max_threads always holds).
   int max_queued_calls = 256;
   /// How long in-flight calls may run on after shutdown begins.
   absl::Duration grace_period = absl::Seconds(10);
