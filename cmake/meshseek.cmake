@@ -3,8 +3,25 @@
 #   meshseek_add_library(NAME geometry SRCS a.cc b.cc DEPS ...)
 #     -> static library target meshseek_geometry (alias meshseek::geometry), include root = repo root
 #   meshseek_add_test(MODULE geometry NAME sobol DEPS ...)
-#     -> executable geometry_sobol_test from sobol_test.cc, registered in CTest as
-#        "geometry/sobol_test" so that `ctest -R geometry/` runs one module.
+#     -> executable geometry_sobol_test from sobol_test.cc whose every GoogleTest
+#        case is its own CTest test, "geometry/sobol_test.Suite.Case", so that
+#        `ctest -R geometry/` runs one module and `ctest -R sobol_test.` one binary
+#        (docs/operations.md, "Continuous integration").
+
+include(GoogleTest)
+
+# Every test's timeout is multiplied by this: 1 in a release build; the
+# sanitizer builds of scripts/sanitize.sh set it to what their slowdown needs.
+set(MESHSEEK_TEST_TIMEOUT_SCALE 1 CACHE STRING
+    "Factor on every test's timeout (scripts/sanitize.sh sets it per sanitizer)")
+
+# Compile options of the tests' own sources only (not of the code they test).
+# The sanitizer builds set -O0: a test's source is mostly GoogleTest macros,
+# whose instrumented code gcc optimises slowly (a unit test 12 s at -O2, 5 s at
+# -O0 under ASan + UBSan), while the work it calls runs in the libraries,
+# optimised as before.
+set(MESHSEEK_TEST_COMPILE_OPTIONS "" CACHE STRING
+    "Compile options of the test sources (scripts/sanitize.sh: -O0)")
 
 function(meshseek_add_library)
   cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
@@ -14,19 +31,82 @@ function(meshseek_add_library)
   target_link_libraries(meshseek_${ARG_NAME} PUBLIC ${ARG_DEPS})
 endfunction()
 
+# meshseek_add_test(MODULE m NAME n DEPS ... [SRCS ...]
+#                   [TIMEOUT s] [CASE_TIMEOUTS "regex=s" ...] [THREADED regex])
+#
+#   TIMEOUT        seconds each case may take in a release build (default 60);
+#   CASE_TIMEOUTS  the cases whose "Suite.Case" name matches a regex get its
+#                  seconds instead (the first match wins): a slow case is sized
+#                  on its own and never takes its neighbours' time;
+#   THREADED       the cases matching this regex ("." for all) exercise the
+#                  multi-threaded paths (servers, dispatcher, ingest stream):
+#                  they get the CTest label `threads`, the ThreadSanitizer step
+#                  runs `ctest -L threads`, and the target joins the
+#                  `threaded_tests` target that step builds.
+# Timeouts are multiplied by MESHSEEK_TEST_TIMEOUT_SCALE. A case's timeout is
+# also its COST, so that a run without CTest's timing history (a fresh clone)
+# starts the slow cases first instead of ending on them one at a time.
 function(meshseek_add_test)
   if(NOT MESHSEEK_BUILD_TESTS)
     return()
   endif()
-  cmake_parse_arguments(ARG "" "MODULE;NAME;TIMEOUT" "DEPS;SRCS" ${ARGN})
+  cmake_parse_arguments(ARG "" "MODULE;NAME;TIMEOUT;THREADED" "DEPS;SRCS;CASE_TIMEOUTS" ${ARGN})
   set(target ${ARG_MODULE}_${ARG_NAME}_test)
   add_executable(${target} ${ARG_NAME}_test.cc ${ARG_SRCS})
   target_link_libraries(${target} PRIVATE ${ARG_DEPS} meshseek::test_main)
-  add_test(NAME ${ARG_MODULE}/${ARG_NAME}_test COMMAND ${target}
-           WORKING_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR})
-  if(ARG_TIMEOUT)
-    set_tests_properties(${ARG_MODULE}/${ARG_NAME}_test PROPERTIES TIMEOUT ${ARG_TIMEOUT})
+  target_compile_options(${target} PRIVATE ${MESHSEEK_TEST_COMPILE_OPTIONS})
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 60)
   endif()
-  set_tests_properties(${ARG_MODULE}/${ARG_NAME}_test PROPERTIES
-    ENVIRONMENT "MESHSEEK_SOURCE_DIR=${PROJECT_SOURCE_DIR};MESHSEEK_BINARY_DIR=${PROJECT_BINARY_DIR}")
+
+  # The cases are listed when ctest runs (PRE_TEST), not at build time, so a
+  # build folder that compiles only some tests (the TSan one) still works.
+  gtest_discover_tests(${target}
+    TEST_PREFIX "${ARG_MODULE}/${ARG_NAME}_test."
+    WORKING_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}
+    DISCOVERY_MODE PRE_TEST
+    DISCOVERY_TIMEOUT 60)
+
+  # What gtest_discover_tests cannot say (a list-valued ENVIRONMENT, a
+  # property per case) is set by a script CTest runs after the discovery,
+  # over the cases it found (${target}_TESTS).
+  set(script "set(_scale ${MESHSEEK_TEST_TIMEOUT_SCALE})\n")
+  string(APPEND script "foreach(_test IN LISTS ${target}_TESTS)\n"
+                       "  string(REPLACE [==[${ARG_MODULE}/${ARG_NAME}_test.]==] \"\" _case \"\${_test}\")\n"
+                       "  set(_timeout ${ARG_TIMEOUT})\n")
+  set(keyword "if")
+  foreach(entry IN LISTS ARG_CASE_TIMEOUTS)
+    if(NOT entry MATCHES "^(.+)=([0-9]+)$")
+      message(FATAL_ERROR "${target}: CASE_TIMEOUTS entry '${entry}' is not regex=seconds")
+    endif()
+    string(APPEND script "  ${keyword}(_case MATCHES [==[${CMAKE_MATCH_1}]==])\n"
+                         "    set(_timeout ${CMAKE_MATCH_2})\n")
+    set(keyword "elseif")
+  endforeach()
+  if(ARG_CASE_TIMEOUTS)
+    string(APPEND script "  endif()\n")
+  endif()
+  string(APPEND script "  math(EXPR _timeout \"\${_timeout} * \${_scale}\")\n"
+                       "  set(_labels \"\")\n")
+  if(DEFINED ARG_THREADED)
+    string(APPEND script "  if(_case MATCHES [==[${ARG_THREADED}]==])\n"
+                         "    set(_labels threads)\n"
+                         "  endif()\n")
+    set_property(GLOBAL APPEND PROPERTY MESHSEEK_THREADED_TESTS ${target})
+  endif()
+  string(APPEND script
+    "  set_tests_properties(\"\${_test}\" PROPERTIES TIMEOUT \${_timeout} COST \${_timeout}\n"
+    "    LABELS \"\${_labels}\"\n"
+    "    ENVIRONMENT \"MESHSEEK_SOURCE_DIR=${PROJECT_SOURCE_DIR};MESHSEEK_BINARY_DIR=${PROJECT_BINARY_DIR}\")\n"
+    "endforeach()\n")
+  set(script_file "${CMAKE_CURRENT_BINARY_DIR}/${target}_case_properties.cmake")
+  file(WRITE "${script_file}" "${script}")
+  set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${script_file}")
+endfunction()
+
+# A script test's (not a GoogleTest binary's) timeout: `seconds` in a release
+# build, times MESHSEEK_TEST_TIMEOUT_SCALE; its COST too, as above.
+function(meshseek_set_test_timeout test seconds)
+  math(EXPR scaled "${seconds} * ${MESHSEEK_TEST_TIMEOUT_SCALE}")
+  set_tests_properties(${test} PROPERTIES TIMEOUT ${scaled} COST ${scaled})
 endfunction()

@@ -2,14 +2,19 @@
 # CI's sanitizer steps, each in its own build folder:
 #   asan  the whole project and every test under AddressSanitizer and
 #         UndefinedBehaviorSanitizer (gcc; build-asan), the whole ctest suite;
-#   tsan  what the services tests need under ThreadSanitizer (gcc;
-#         build-tsan), and the services and end-to-end tests (the CLI's
-#         ingest stream and the servers are the multi-threaded code);
+#   tsan  the tests of the multi-threaded paths under ThreadSanitizer (gcc;
+#         build-tsan): the servers, the dispatcher, the CLI's ingest stream,
+#         the thread pool and what runs on it, i.e. the cases labelled
+#         `threads` (meshseek_add_test's THREADED), and only what they need
+#         is compiled (the `threaded_tests` target);
 #   fuzz  the libFuzzer harnesses (clang; build-fuzz), each for a short run
 #         over its seed corpus (FUZZ_SECONDS, default 20).
 #
 #   scripts/sanitize.sh            # all three, in this order
 #   scripts/sanitize.sh tsan fuzz  # some of them
+#
+# Timeouts are each test's release timeout times 3 (ASan) or 4 (TSan), and
+# the tests use smaller data under a sanitizer (common/base/test_env.h).
 #
 # The services tests start the servers as child processes whose output goes
 # to log files, and kill them with SIGKILL; a sanitizer report there would not
@@ -34,15 +39,34 @@ end() {
   echo "=== sanitize: ${summary[-1]}"
 }
 
-# Configures $1 (once) with compiler $2, compile flags $3 and link flags $4.
+# Configures $1 (once) with compiler $2, compile flags $3, link flags $4 and
+# the factor $5 on every test's timeout (MESHSEEK_TEST_TIMEOUT_SCALE).
 configure() {
-  local dir=$1 cxx=$2 flags=$3 link=$4
+  local dir=$1 cxx=$2 flags=$3 link=$4 scale=$5
   if [ ! -f "$dir/build.ninja" ]; then
     cmake -S . -B "$dir" -G Ninja -DCMAKE_CXX_COMPILER="$cxx" \
       -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" \
       -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="$link" \
-      -DMESHSEEK_BUILD_BENCHMARKS=OFF
+      -DMESHSEEK_BUILD_BENCHMARKS=OFF -DMESHSEEK_TEST_TIMEOUT_SCALE="$scale" \
+      -DMESHSEEK_TEST_COMPILE_OPTIONS=-O0
   fi
+}
+
+# Runs ctest in $1 with the remaining arguments, its reports in $1's
+# sanitizer-reports/, then prints each test's time against its timeout.
+run_ctest() {
+  local dir=$1
+  shift
+  local reports=$PWD/$dir/sanitizer-reports
+  rm -rf "$reports" && mkdir -p "$reports/tmp"
+  rc=0
+  # The test processes keep their folders (servers' logs) for check_reports.
+  TEST_TMPDIR=$reports/tmp MESHSEEK_KEEP_TEST_TMPDIR=1 \
+    ctest --test-dir "$dir" --output-on-failure -j"$JOBS" --output-junit "$PWD/$dir/junit.xml" \
+      "$@" || rc=$?
+  python3 scripts/test_times.py "$dir" "$dir/junit.xml" || true
+  check_reports "$reports" || rc=1
+  [ "$rc" -eq 0 ] || exit "$rc"
 }
 
 # Fails when any process of the run left a sanitizer report in $1: a
@@ -69,21 +93,16 @@ for step in $STEPS; do
     asan)
       begin "ASan + UBSan: whole project, whole test suite (build-asan)"
       flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
-      configure build-asan g++ "$flags" "$flags"
+      configure build-asan g++ "$flags" "$flags" 3
       cmake --build build-asan -- -j"$JOBS"
-      reports=$PWD/build-asan/sanitizer-reports
-      rm -rf "$reports" && mkdir -p "$reports/tmp"
-      TEST_TMPDIR=$reports/tmp \
-      ASAN_OPTIONS="log_path=$reports/asan:detect_leaks=1:strict_string_checks=1:check_initialization_order=1" \
+      ASAN_OPTIONS="log_path=$PWD/build-asan/sanitizer-reports/asan:detect_leaks=1:strict_string_checks=1:check_initialization_order=1" \
       LSAN_OPTIONS="suppressions=$SUPP/lsan.supp:print_suppressions=0" \
       UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
-        ctest --test-dir build-asan --output-on-failure -j"$JOBS" || rc=$?
-      check_reports "$reports" || rc=1
-      [ "${rc:-0}" -eq 0 ] || exit "$rc"
+        run_ctest build-asan
       end asan "ctest, every test"
       ;;
     tsan)
-      begin "TSan: services and end-to-end tests (build-tsan)"
+      begin "TSan: the tests of the multi-threaded paths (build-tsan)"
       # Every TSan executable links the absl::Mutex annotations first, so that
       # its Mutex entry points win over Debian's uninstrumented ones
       # (scripts/sanitizers/absl_mutex_tsan.cc says why).
@@ -94,19 +113,11 @@ for step in $STEPS; do
           -labsl_synchronization -ldl
       fi
       configure build-tsan g++ "-fsanitize=thread -fno-omit-frame-pointer" \
-        "-fsanitize=thread -Wl,--no-as-needed $shim -Wl,--as-needed"
-      cmake --build build-tsan --target tests_services_test tests_end_to_end_test \
-        tests_hostile_input_test tests_security_test tests_report_test tests_metrics_test \
-        meshseek meshseek-probe \
-        -- -j"$JOBS"
-      reports=$PWD/build-tsan/sanitizer-reports
-      rm -rf "$reports" && mkdir -p "$reports/tmp"
-      TEST_TMPDIR=$reports/tmp \
-      TSAN_OPTIONS="log_path=$reports/tsan:suppressions=$SUPP/tsan.supp:halt_on_error=0:second_deadlock_stack=1" \
-        ctest --test-dir build-tsan --output-on-failure -R '^tests/' -j"$JOBS" || rc=$?
-      check_reports "$reports" || rc=1
-      [ "${rc:-0}" -eq 0 ] || exit "$rc"
-      end tsan "ctest -R ^tests/ (services, end to end)"
+        "-fsanitize=thread -Wl,--no-as-needed $shim -Wl,--as-needed" 4
+      cmake --build build-tsan --target threaded_tests -- -j"$JOBS"
+      TSAN_OPTIONS="log_path=$PWD/build-tsan/sanitizer-reports/tsan:suppressions=$SUPP/tsan.supp:halt_on_error=0:second_deadlock_stack=1" \
+        run_ctest build-tsan -L '^threads$'
+      end tsan "ctest -L threads"
       ;;
     fuzz)
       begin "libFuzzer: every harness for ${FUZZ_SECONDS:-20} s (build-fuzz)"

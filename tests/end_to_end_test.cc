@@ -11,6 +11,7 @@
 #include <string>
 
 #include "common/base/file_io.h"
+#include "common/base/test_env.h"
 #include "common/eval/distance_matrix.h"
 #include "common/pipeline/collection_evaluation.h"
 #include "common/synth/synthetic_benchmark.h"
@@ -30,6 +31,11 @@ RetrievalPipelineOptions SmallOptions() {
   return options;
 }
 
+// The synthetic benchmark's 9 classes, 8 models each; under a sanitizer 4
+// each (common/base/test_env.h): the same paths run on half the models.
+constexpr int kModelsPerClass = kSanitized ? 4 : 8;
+constexpr std::size_t kModels = 9 * kModelsPerClass;
+
 class EndToEndTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -38,7 +44,9 @@ class EndToEndTest : public ::testing::Test {
     // The CLI's embedded stack keeps collections (and their features) here:
     // start clean so that no run reuses features of an older build.
     std::filesystem::remove_all(::testing::TempDir() + "/meshseek-data");
-    ASSERT_TRUE(GenerateSyntheticBenchmark(SyntheticBenchmarkOptions(), *dir_ + "/bench").ok());
+    SyntheticBenchmarkOptions benchmark;
+    benchmark.models_per_class = kModelsPerClass;
+    ASSERT_TRUE(GenerateSyntheticBenchmark(benchmark, *dir_ + "/bench").ok());
   }
   static void TearDownTestSuite() { delete dir_; }
   static std::string* dir_;
@@ -63,15 +71,15 @@ int RunCommand(const std::string& command, std::string* output) {
 TEST_F(EndToEndTest, PipelineRanksSyntheticClassesWellAboveChance) {
   auto models = ReadManifest(*dir_ + "/bench/manifest.csv");
   ASSERT_TRUE(models.ok()) << models.status();
-  ASSERT_EQ(models->size(), 72u);
+  ASSERT_EQ(models->size(), kModels);
   auto evaluation = EvaluateCollection(*models, CollectionOptions::Of(SmallOptions()));
   ASSERT_TRUE(evaluation.ok()) << evaluation.status();
-  // Chance first tier is 7/71 (10 %). The shapes are built to be told apart by
+  // Chance first tier is 7/71 (10 %; 3/35 under a sanitizer). The shapes are built to be told apart by
   // local surface shape, with soups, several components and sparse and dense
   // tessellations in every class.
   EXPECT_GT(evaluation->metrics.micro.rp_excl, 0.6);
   EXPECT_GT(evaluation->metrics.micro.nn, 0.8);
-  EXPECT_EQ(evaluation->metrics.queries, 72u);
+  EXPECT_EQ(evaluation->metrics.queries, kModels);
   for (std::size_t n : evaluation->methods[0].features_per_model) EXPECT_GT(n, 400u);
 
   // The same run twice gives the same matrix: extraction, k-means and ranking
@@ -93,9 +101,9 @@ TEST_F(EndToEndTest, CliEvalWritesMatrixAndMetricsThatTheReferenceEvaluatorAgree
   ASSERT_EQ(code, 0) << output;
   EXPECT_THAT(output, HasSubstr("RP_excl"));
   EXPECT_THAT(output, HasSubstr("micro"));
-  auto matrix = ReadDistanceMatrix(out + "/distances.bin", 72);
+  auto matrix = ReadDistanceMatrix(out + "/distances.bin", kModels);
   ASSERT_TRUE(matrix.ok()) << matrix.status();
-  for (std::size_t i = 0; i < 72; ++i) EXPECT_EQ((*matrix)[i * 72 + i], 0.0f);
+  for (std::size_t i = 0; i < kModels; ++i) EXPECT_EQ((*matrix)[i * kModels + i], 0.0f);
   auto json = ReadFileToString(out + "/metrics.json");
   ASSERT_TRUE(json.ok());
   EXPECT_THAT(*json, HasSubstr("\"RP_excl\""));
@@ -137,7 +145,7 @@ TEST_F(EndToEndTest, EveryMethodRunsThroughTheCliWithTheSameOutputs) {
         &output);
     ASSERT_EQ(code, 0) << output;
     EXPECT_THAT(output, HasSubstr("RP_excl"));
-    EXPECT_TRUE(ReadDistanceMatrix(out + "/distances.bin", 72).ok());
+    EXPECT_TRUE(ReadDistanceMatrix(out + "/distances.bin", kModels).ok());
     auto json = ReadFileToString(out + "/metrics.json");
     ASSERT_TRUE(json.ok());
     EXPECT_THAT(*json, HasSubstr("\"method\": \"" + method + "\""));

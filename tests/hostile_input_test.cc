@@ -22,6 +22,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
+#include "common/base/test_env.h"
 #include "common/rpc/client.h"
 #include "common/rpc/free_port.h"
 #include "gmock/gmock.h"
@@ -150,13 +151,7 @@ double ResidentMiB(pid_t pid) {
 // machine), returning its exit code and stderr+stdout. Not under
 // AddressSanitizer or ThreadSanitizer, whose shadow memory reserves terabytes
 // of address space (they catch such allocations themselves).
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr const char* kAddressSpaceLimit = "";
-constexpr int kSlowdown = 10;  // the time bounds below, under a sanitizer
-#else
-constexpr const char* kAddressSpaceLimit = "ulimit -v 4194304; ";
-constexpr int kSlowdown = 1;
-#endif
+constexpr const char* kAddressSpaceLimit = kSanitized ? "" : "ulimit -v 4194304; ";
 int RunCli(const std::string& args, std::string* output) {
   FILE* pipe = popen(
       (kAddressSpaceLimit + std::string(MESHSEEK_CLI_PATH) + " " + args + " 2>&1").c_str(), "r");

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Runs the fuzz harnesses one at a time over their seed corpora and prints one
-# line per harness: executions, final corpus (files and bytes), seconds.
+# Runs the fuzz harnesses over their seed corpora, JOBS at a time (default:
+# the number of cores; each harness is one single-threaded process), and
+# prints one line per harness as it ends: executions, final corpus (files and
+# bytes), seconds.
 #
 #   tests/fuzz/run.sh BUILD_DIR [libFuzzer flags...]
 #   tests/fuzz/run.sh build-fuzz -max_total_time=20        # CI's short run
@@ -19,14 +21,17 @@ shift
 ALL="mesh_off mesh_obj mesh_ply mesh_stl mesh_detect manifest class_file
      convert_mesh convert_features convert_graph convert_histogram convert_params"
 FUZZERS=${FUZZERS:-$ALL}
+JOBS=${JOBS:-$(nproc)}
 mkdir -p "$BUILD_DIR/fuzz-logs" "$BUILD_DIR/fuzz-artifacts"
-failed=0
-for h in $FUZZERS; do
-  work="$BUILD_DIR/fuzz-corpus/$h"
-  log="$BUILD_DIR/fuzz-logs/$h.log"
+
+# One harness; its exit code also goes to fuzz-logs/<harness>.rc.
+fuzz() {
+  local h=$1
+  shift
+  local work="$BUILD_DIR/fuzz-corpus/$h" log="$BUILD_DIR/fuzz-logs/$h.log"
+  local start rc=0 seconds runs files bytes
   mkdir -p "$work"
   start=$(date +%s.%N)
-  rc=0
   # -max_len: the seeds are a few hundred bytes; 4 KB leaves room for every
   # header and body structure while keeping executions fast.
   "$BUILD_DIR/tests/fuzz/fuzz_$h" -rss_limit_mb=2048 -timeout=5 -max_len=4096 \
@@ -39,8 +44,19 @@ for h in $FUZZERS; do
   printf '%-18s %12s execs  corpus %6d files %9d bytes  %8.1f s  rc %d\n' \
       "$h" "${runs:-?}" "$files" "$bytes" "$seconds" "$rc"
   if [ "$rc" -ne 0 ]; then
-    failed=1
     grep -E 'ERROR|SUMMARY|Test unit written' "$log" | head -5 || true
   fi
+  echo "$rc" >"$BUILD_DIR/fuzz-logs/$h.rc"
+}
+
+for h in $FUZZERS; do
+  rm -f "$BUILD_DIR/fuzz-logs/$h.rc"
+  while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do wait -n || true; done
+  fuzz "$h" "$@" &
+done
+wait
+failed=0
+for h in $FUZZERS; do
+  [ "$(cat "$BUILD_DIR/fuzz-logs/$h.rc" 2>/dev/null)" = 0 ] || failed=1
 done
 exit $failed
