@@ -7,6 +7,8 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
 
 // Returns the status from the enclosing function if `expr` is not OK.
 #define MESHSEEK_RETURN_IF_ERROR(expr)           \
@@ -27,5 +29,16 @@
   auto statusor = (expr);                                    \
   if (!statusor.ok()) return std::move(statusor).status();   \
   lhs = std::move(statusor).value()
+
+namespace meshseek {
+
+/// `status` with `prefix` before its message (same code), so an error names
+/// where it happened: Prefixed(s, "model m1: "). OK stays OK.
+inline absl::Status Prefixed(const absl::Status& status, absl::string_view prefix) {
+  if (status.ok()) return status;
+  return absl::Status(status.code(), absl::StrCat(prefix, status.message()));
+}
+
+}  // namespace meshseek
 
 #endif  // MESHSEEK_COMMON_BASE_STATUS_MACROS_H_

@@ -2,7 +2,7 @@
 // extract service select a method by name and never depend on which one it
 // is. The method table (FeatureMethods) is the one registration of a method:
 // its name, kind, measured vocabulary, validation and extraction; its
-// parameters are in common/pipeline/pipeline_params.cc.
+// parameters are rows of common/pipeline/pipeline_param_table.cc.
 #ifndef MESHSEEK_COMMON_FEATURES_LOCAL_FEATURE_EXTRACTOR_H_
 #define MESHSEEK_COMMON_FEATURES_LOCAL_FEATURE_EXTRACTOR_H_
 
@@ -33,7 +33,7 @@ enum class DescriptorKind { kBagOfFeatures, kGlobal };
 struct ExtractorOptions;
 
 // The registration of one method: the table every name, listing and kind
-// lookup consults (its parameters are in common/pipeline/pipeline_params.cc).
+// lookup consults (its parameters are rows of common/pipeline/pipeline_param_table.cc).
 struct FeatureMethodInfo {
   FeatureMethod method;
   /// --method value, lower case.

@@ -5,10 +5,13 @@
 // follows from this table: the CLI's flags and their help
 // (cli/pipeline_flags), the collection parameters of the services
 // (PipelineParams.values, rpc/convert), their validation and canonical form,
-// and the parameter block of metrics.json. Adding a parameter is one entry in
-// pipeline_params.cc (and its field in the method's option struct); a new
-// method registers itself in common/features/local_feature_extractor.cc and
-// lists its parameters here.
+// and the parameter block of metrics.json. Adding a parameter is one row of
+// the table in pipeline_param_table.cc (and its field in the method's option
+// struct); a new method registers itself in
+// common/features/local_feature_extractor.cc and names itself in the rows of
+// its parameters. Parsing and validation are pipeline_params.cc, metrics.json
+// and --help pipeline_params_text.cc; testdata/pipeline_params.golden pins
+// what all three produce (pipeline_params_golden_test).
 //
 // Values travel as text ("1024", "0.2", "true", "dominant"), parsed by the
 // parameter's type and checked against its range, so that a new parameter
@@ -69,6 +72,8 @@ struct ParamSpec {
   std::function<void(absl::string_view, CollectionOptions*)> collection_set;
 
   bool AppliesTo(FeatureMethod method) const;
+  /// "dld, lsf", "bag-of-features methods", "every method", "the collection".
+  std::string AppliesToText() const;
   /// "int in [1, 1000000]", "one of dominant, up", ...
   std::string TypeDescription() const;
 };

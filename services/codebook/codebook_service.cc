@@ -6,7 +6,6 @@
 #include "common/base/status_macros.h"
 #include "common/features/sift_descriptor.h"
 #include "common/rpc/convert.h"
-#include "common/rpc/status.h"
 
 namespace meshseek {
 
@@ -28,11 +27,13 @@ absl::StatusOr<std::unique_ptr<CodebookService>> CodebookService::Create(
   return std::unique_ptr<CodebookService>(new CodebookService(options, std::move(db)));
 }
 
-void CodebookService::Describe(const std::string& id, const Entry& entry, v1::CodebookInfo* info) {
-  info->set_codebook_id(id);
-  info->set_size(static_cast<uint32_t>(entry.codebook->size()));
-  info->set_dimension(static_cast<uint32_t>(entry.codebook->dim()));
-  info->set_training_descriptors(entry.training_descriptors);
+v1::CodebookInfo CodebookService::Describe(const std::string& id, const Entry& entry) {
+  v1::CodebookInfo info;
+  info.set_codebook_id(id);
+  info.set_size(static_cast<uint32_t>(entry.codebook->size()));
+  info.set_dimension(static_cast<uint32_t>(entry.codebook->dim()));
+  info.set_training_descriptors(entry.training_descriptors);
+  return info;
 }
 
 absl::StatusOr<CodebookService::Entry> CodebookService::Find(const std::string& id) {
@@ -51,119 +52,94 @@ absl::StatusOr<CodebookService::Entry> CodebookService::Find(const std::string& 
   return entry;
 }
 
-grpc::Status CodebookService::Train(grpc::ServerContext* context,
-                                    grpc::ServerReader<v1::TrainCodebookRequest>* reader,
-                                    v1::CodebookInfo* response) {
+absl::StatusOr<v1::CodebookInfo> CodebookService::Train(
+    rpc::Reader<v1::TrainCodebookRequest> read, const rpc::CallContext& call) {
   v1::TrainCodebookRequest first;
-  if (!reader->Read(&first)) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "train: empty request stream");
-  }
+  if (!read(&first)) return absl::InvalidArgumentError("train: empty request stream");
   const std::string id = first.codebook_id();
-  if (id.empty()) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "train: codebook_id is empty");
-  }
+  if (id.empty()) return absl::InvalidArgumentError("train: codebook_id is empty");
+  // Every later error names the codebook.
+  const std::string where = absl::StrCat("train ", id, ": ");
+  auto fail = [&where](const absl::Status& status) { return Prefixed(status, where); };
   absl::MutexLock training(&train_mutex_);
   if (absl::StatusOr<Entry> existing = Find(id); existing.ok()) {
     v1::TrainCodebookRequest rest;
-    while (reader->Read(&rest)) {
+    while (read(&rest)) {
     }
-    Describe(id, *existing, response);
-    return grpc::Status::OK;
+    return Describe(id, *existing);
   }
   const std::size_t dim = first.dimension();
   if (dim == 0 || dim > kMaxDescriptorDimension) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                        absl::StrCat("train ",
-                                     id,
-                                     ": descriptor dimension ",
-                                     dim,
-                                     ", expected 1 to ",
-                                     kMaxDescriptorDimension));
+    return fail(absl::InvalidArgumentError(absl::StrCat(
+        "descriptor dimension ", dim, ", expected 1 to ", kMaxDescriptorDimension)));
   }
   std::string descriptors = first.descriptors();
   v1::TrainCodebookRequest chunk;
-  for (int index = 1; reader->Read(&chunk); ++index) {
+  for (int index = 1; read(&chunk); ++index) {
     if (chunk.dimension() != 0 && chunk.dimension() != dim) {
-      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                          absl::StrCat("train ", id, ": chunk ", index, " has dimension ",
-                                       chunk.dimension(), ", the first had ", dim));
+      return fail(absl::InvalidArgumentError(absl::StrCat(
+          "chunk ", index, " has dimension ", chunk.dimension(), ", the first had ", dim)));
     }
     descriptors += chunk.descriptors();
   }
   // A stream also ends when its client dies (a coordinator killed mid-build):
   // that is a cut-off sample, and a codebook trained on it and stored under
   // the build's id would be what the resumed build finds and uses.
-  if (context->IsCancelled()) {
-    return grpc::Status(grpc::StatusCode::CANCELLED,
-                        absl::StrCat("train ", id, ": the stream was cut off; nothing trained"));
+  if (call.cancelled()) {
+    return fail(absl::CancelledError("the stream was cut off; nothing trained"));
   }
   if (descriptors.size() % dim != 0) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                        absl::StrCat("train ", id, ": ", descriptors.size(),
-                                     " descriptor bytes are not a multiple of ", dim));
+    return fail(absl::InvalidArgumentError(absl::StrCat(
+        descriptors.size(), " descriptor bytes are not a multiple of ", dim)));
   }
   // The same k-means options as the in-process pipeline's
   // TrainCollectionCodebook: the collection's.
   absl::StatusOr<RetrievalPipelineOptions> params = rpc::PipelineOptionsFromParams(first.params());
-  if (!params.ok()) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                        absl::StrCat("train ", id, ": ", params.status().message()));
-  }
+  if (!params.ok()) return fail(absl::InvalidArgumentError(params.status().message()));
   KMeansOptions kmeans = params->kmeans;
   kmeans.num_threads = options_.num_threads;
   kmeans.sampled_from = first.sampled_from();
   const std::size_t count = descriptors.size() / dim;
   absl::StatusOr<Codebook> codebook = Codebook::Train(
       reinterpret_cast<const uint8_t*>(descriptors.data()), count, dim, kmeans);
-  if (!codebook.ok()) {
-    return rpc::ToGrpcStatus(absl::Status(
-        codebook.status().code(), absl::StrCat("train ", id, ": ", codebook.status().message())));
-  }
+  if (!codebook.ok()) return fail(codebook.status());
   // What the codebook was trained from: the whole set when a sample was sent.
   Entry entry{std::make_shared<const Codebook>(*std::move(codebook)),
               first.sampled_from() > 0 ? first.sampled_from() : count};
   {
     absl::MutexLock lock(&mutex_);
-    absl::StatusOr<Statement> insert =
+    MESHSEEK_ASSIGN_OR_RETURN(
+        Statement insert,
         db_->Prepare("INSERT OR REPLACE INTO codebooks (id, training_descriptors, data) "
-                     "VALUES (?, ?, ?)");
-    absl::Status stored = insert.ok() ? insert->Bind(1, id)
-                                            .Bind(2, static_cast<int64_t>(count))
-                                            .BindBlob(3, entry.codebook->Serialize())
-                                            .Run()
-                                      : insert.status();
-    if (!stored.ok()) return rpc::ToGrpcStatus(stored);
+                     "VALUES (?, ?, ?)"));
+    MESHSEEK_RETURN_IF_ERROR(insert.Bind(1, id)
+                                 .Bind(2, static_cast<int64_t>(count))
+                                 .BindBlob(3, entry.codebook->Serialize())
+                                 .Run());
     cache_[id] = entry;
   }
-  Describe(id, entry, response);
-  return grpc::Status::OK;
+  return Describe(id, entry);
 }
 
-grpc::Status CodebookService::Encode(grpc::ServerContext*,
-                                     const v1::EncodeRequest* request,
-                                     v1::EncodeResponse* response) {
-  absl::StatusOr<Entry> entry = Find(request->codebook_id());
-  if (!entry.ok()) return rpc::ToGrpcStatus(entry.status());
-  absl::StatusOr<LocalFeatures> features = rpc::FeaturesFromProto(request->features());
-  if (!features.ok()) return rpc::ToGrpcStatus(features.status());
+absl::StatusOr<v1::EncodeResponse> CodebookService::Encode(const v1::EncodeRequest& request,
+                                                           const rpc::CallContext&) {
+  MESHSEEK_ASSIGN_OR_RETURN(const Entry entry, Find(request.codebook_id()));
+  MESHSEEK_ASSIGN_OR_RETURN(const LocalFeatures features, rpc::FeaturesFromProto(request.features()));
   std::vector<float> histogram;  // empty: a model without features
-  if (features->size() > 0) {
-    absl::StatusOr<std::vector<float>> encoded = entry->codebook->Encode(
-        features->descriptors.data(), features->size(), features->dimension);
-    if (!encoded.ok()) return rpc::ToGrpcStatus(encoded.status());
-    histogram = *std::move(encoded);
+  if (features.size() > 0) {
+    MESHSEEK_ASSIGN_OR_RETURN(
+        histogram,
+        entry.codebook->Encode(features.descriptors.data(), features.size(), features.dimension));
   }
-  rpc::HistogramToProto(histogram, entry->codebook->size(), response->mutable_histogram());
-  return grpc::Status::OK;
+  v1::EncodeResponse response;
+  rpc::HistogramToProto(histogram, entry.codebook->size(), response.mutable_histogram());
+  return response;
 }
 
-grpc::Status CodebookService::GetCodebook(grpc::ServerContext*,
-                                          const v1::GetCodebookRequest* request,
-                                          v1::CodebookInfo* response) {
-  absl::StatusOr<Entry> entry = Find(request->codebook_id());
-  if (!entry.ok()) return rpc::ToGrpcStatus(entry.status());
-  Describe(request->codebook_id(), *entry, response);
-  return grpc::Status::OK;
+absl::StatusOr<v1::CodebookInfo> CodebookService::GetCodebook(
+    const v1::GetCodebookRequest& request, const rpc::CallContext&) {
+  MESHSEEK_ASSIGN_OR_RETURN(const Entry entry, Find(request.codebook_id()));
+  return Describe(request.codebook_id(), entry);
 }
 
 }  // namespace meshseek

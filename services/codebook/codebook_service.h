@@ -16,6 +16,7 @@
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "common/bof/codebook.h"
+#include "common/rpc/handler.h"
 #include "common/store/sqlite_db.h"
 #include "meshseek/v1/codebook.grpc.pb.h"
 
@@ -36,15 +37,29 @@ class CodebookService final : public v1::Codebook::Service {
   static absl::StatusOr<std::unique_ptr<CodebookService>> Create(
       const CodebookServiceOptions& options);
 
+  absl::StatusOr<v1::CodebookInfo> Train(rpc::Reader<v1::TrainCodebookRequest> read,
+                                         const rpc::CallContext& call);
+  absl::StatusOr<v1::EncodeResponse> Encode(const v1::EncodeRequest& request,
+                                            const rpc::CallContext& call);
+  absl::StatusOr<v1::CodebookInfo> GetCodebook(const v1::GetCodebookRequest& request,
+                                               const rpc::CallContext& call);
+
+  // gRPC entry points (common/rpc/handler.h).
   grpc::Status Train(grpc::ServerContext* context,
                      grpc::ServerReader<v1::TrainCodebookRequest>* reader,
-                     v1::CodebookInfo* response) override;
+                     v1::CodebookInfo* response) override {
+    return rpc::Serve(context, reader, response, this, &CodebookService::Train);
+  }
   grpc::Status Encode(grpc::ServerContext* context,
                       const v1::EncodeRequest* request,
-                      v1::EncodeResponse* response) override;
+                      v1::EncodeResponse* response) override {
+    return rpc::Serve(context, request, response, this, &CodebookService::Encode);
+  }
   grpc::Status GetCodebook(grpc::ServerContext* context,
                            const v1::GetCodebookRequest* request,
-                           v1::CodebookInfo* response) override;
+                           v1::CodebookInfo* response) override {
+    return rpc::Serve(context, request, response, this, &CodebookService::GetCodebook);
+  }
 
  private:
   struct Entry {
@@ -55,7 +70,7 @@ class CodebookService final : public v1::Codebook::Service {
       : options_(options), db_(std::move(db)) {}
   // The stored codebook, or NotFound naming the id.
   absl::StatusOr<Entry> Find(const std::string& id);
-  static void Describe(const std::string& id, const Entry& entry, v1::CodebookInfo* info);
+  static v1::CodebookInfo Describe(const std::string& id, const Entry& entry);
 
   const CodebookServiceOptions options_;
   absl::Mutex mutex_;

@@ -16,10 +16,6 @@ namespace {
 
 constexpr std::size_t kTrainChunkBytes = 4 << 20;
 
-absl::Status Prefixed(const absl::Status& status, const std::string& prefix) {
-  return absl::Status(status.code(), absl::StrCat(prefix, status.message()));
-}
-
 }  // namespace
 
 BuildRunner::BuildRunner(CoordinatorStore* store,

@@ -9,7 +9,6 @@
 #include "common/base/status_macros.h"
 #include "common/render/thumbnail.h"
 #include "common/rpc/convert.h"
-#include "common/rpc/status.h"
 
 namespace meshseek {
 namespace {
@@ -31,10 +30,6 @@ absl::Status CheckName(const std::string& what, const std::string& name, std::si
     }
   }
   return absl::OkStatus();
-}
-
-absl::Status Prefixed(const absl::Status& status, const std::string& prefix) {
-  return absl::Status(status.code(), absl::StrCat(prefix, status.message()));
 }
 
 // meshseek_coordinator_models: every stored collection with all three
@@ -127,25 +122,19 @@ absl::StatusOr<v1::Collection> CoordinatorService::DescribeCollection(const std:
   return collection;
 }
 
-grpc::Status CoordinatorService::CreateCollection(grpc::ServerContext*,
-                                                  const v1::CreateCollectionRequest* request,
-                                                  v1::Collection* response) {
-  if (absl::Status name = CheckName("collection name", request->name(), 128, true); !name.ok()) {
-    return rpc::ToGrpcStatus(name);
-  }
-  absl::StatusOr<CollectionOptions> valid = rpc::CollectionOptionsFromParams(request->params());
-  if (!valid.ok()) {
-    return rpc::ToGrpcStatus(Prefixed(valid.status(), absl::StrCat("collection '", request->name(), "': ")));
-  }
+absl::StatusOr<v1::Collection> CoordinatorService::CreateCollection(
+    const v1::CreateCollectionRequest& request, const rpc::CallContext&) {
+  MESHSEEK_RETURN_IF_ERROR(CheckName("collection name", request.name(), 128, true));
+  const std::string where = absl::StrCat("collection '", request.name(), "'");
+  absl::StatusOr<CollectionOptions> valid = rpc::CollectionOptionsFromParams(request.params());
+  if (!valid.ok()) return Prefixed(valid.status(), where + ": ");
   for (const RetrievalPipelineOptions& method : valid->methods) {
     if (method.weighting.idf) {
-      return grpc::Status(
-          grpc::StatusCode::INVALID_ARGUMENT,
-          absl::StrCat("collection '",
-                       request->name(),
-                       "': idf=true needs the whole "
-                       "collection's document frequencies, which the services do not keep; "
-                       "evaluate it in process (meshseek eval --server in-process)"));
+      return absl::InvalidArgumentError(absl::StrCat(
+          where,
+          ": idf=true needs the whole "
+          "collection's document frequencies, which the services do not keep; "
+          "evaluate it in process (meshseek eval --server in-process)"));
     }
   }
   // Stored canonical: every parameter with its value, so the collection
@@ -153,138 +142,109 @@ grpc::Status CoordinatorService::CreateCollection(grpc::ServerContext*,
   // same parameters however written is not a conflict.
   v1::PipelineParams canonical;
   rpc::CollectionParamsToProto(*valid, &canonical);
-  if (absl::StatusOr<StoredCollection> existing = store_->GetCollection(request->name());
+  if (absl::StatusOr<StoredCollection> existing = store_->GetCollection(request.name());
       existing.ok()) {
     absl::StatusOr<CollectionOptions> stored = rpc::CollectionOptionsFromParams(existing->params);
     v1::PipelineParams stored_canonical;
     if (stored.ok()) rpc::CollectionParamsToProto(*stored, &stored_canonical);
     if (!stored.ok() || stored_canonical.SerializeAsString() != canonical.SerializeAsString()) {
-      return grpc::Status(
-          grpc::StatusCode::ALREADY_EXISTS,
-          absl::StrCat("collection '", request->name(), "' exists with other parameters"));
+      return absl::AlreadyExistsError(absl::StrCat(where, " exists with other parameters"));
     }
   } else {
     // A fused collection and its members, one per method, together.
-    std::vector<std::pair<std::string, v1::PipelineParams>> rows = {{request->name(), canonical}};
+    std::vector<std::pair<std::string, v1::PipelineParams>> rows = {{request.name(), canonical}};
     if (valid->fused()) {
       for (const RetrievalPipelineOptions& method : valid->methods) {
         v1::PipelineParams params;
         rpc::PipelineParamsToProto(method, &params);
-        rows.emplace_back(MemberCollectionName(request->name(), method.extractor.method), params);
+        rows.emplace_back(MemberCollectionName(request.name(), method.extractor.method), params);
       }
     }
-    if (absl::Status s = store_->CreateCollections(rows); !s.ok()) return rpc::ToGrpcStatus(s);
+    MESHSEEK_RETURN_IF_ERROR(store_->CreateCollections(rows));
   }
-  absl::StatusOr<v1::Collection> collection = DescribeCollection(request->name());
-  if (!collection.ok()) return rpc::ToGrpcStatus(collection.status());
-  *response = *std::move(collection);
-  return grpc::Status::OK;
+  return DescribeCollection(request.name());
 }
 
-grpc::Status CoordinatorService::GetCollection(grpc::ServerContext*,
-                                               const v1::GetCollectionRequest* request,
-                                               v1::Collection* response) {
-  absl::StatusOr<v1::Collection> collection = DescribeCollection(request->name());
-  if (!collection.ok()) return rpc::ToGrpcStatus(collection.status());
-  *response = *std::move(collection);
-  return grpc::Status::OK;
+absl::StatusOr<v1::Collection> CoordinatorService::GetCollection(
+    const v1::GetCollectionRequest& request, const rpc::CallContext&) {
+  return DescribeCollection(request.name());
 }
 
-grpc::Status CoordinatorService::ListCollections(grpc::ServerContext*,
-                                                 const v1::ListCollectionsRequest*,
-                                                 v1::ListCollectionsResponse* response) {
-  absl::StatusOr<std::vector<std::string>> names = store_->ListCollectionNames();
-  if (!names.ok()) return rpc::ToGrpcStatus(names.status());
-  for (const std::string& name : *names) {
+absl::StatusOr<v1::ListCollectionsResponse> CoordinatorService::ListCollections(
+    const v1::ListCollectionsRequest&, const rpc::CallContext&) {
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<std::string> names, store_->ListCollectionNames());
+  v1::ListCollectionsResponse response;
+  for (const std::string& name : names) {
     absl::StatusOr<v1::Collection> collection = DescribeCollection(name);
     // Removed meanwhile, or parameters this release cannot read: skip it
     // here; GetCollection says why.
     if (!collection.ok()) continue;
-    *response->add_collections() = *std::move(collection);
+    *response.add_collections() = *std::move(collection);
   }
-  return grpc::Status::OK;
+  return response;
 }
 
-grpc::Status CoordinatorService::GetThumbnail(grpc::ServerContext*,
-                                              const v1::GetThumbnailRequest* request,
-                                              v1::Thumbnail* response) {
-  absl::StatusOr<CollectionPlan> plan = PublicPlan(request->collection());
-  if (!plan.ok()) return rpc::ToGrpcStatus(plan.status());
-  const ModelKey key{request->collection(), request->model_id()};
-  absl::StatusOr<std::optional<std::string>> png = store_->GetThumbnail(key);
-  if (!png.ok()) return rpc::ToGrpcStatus(png.status());
-  if (png->has_value()) {
-    response->set_png(**std::move(png));
-    return grpc::Status::OK;
+absl::StatusOr<v1::Thumbnail> CoordinatorService::GetThumbnail(
+    const v1::GetThumbnailRequest& request, const rpc::CallContext&) {
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionPlan plan, PublicPlan(request.collection()));
+  const ModelKey key{request.collection(), request.model_id()};
+  MESHSEEK_ASSIGN_OR_RETURN(std::optional<std::string> png, store_->GetThumbnail(key));
+  v1::Thumbnail response;
+  if (png.has_value()) {
+    response.set_png(*std::move(png));
+    return response;
   }
   // Not drawn at ingest (stored by an earlier release, or not drawable):
   // draw it from the stored mesh now and keep it.
-  absl::StatusOr<std::optional<std::string>> stored =
-      store_->ModelMesh({plan->parts.front().name, request->model_id()});
-  if (!stored.ok()) return rpc::ToGrpcStatus(stored.status());
-  if (!stored->has_value()) {
-    return grpc::Status(
-        grpc::StatusCode::NOT_FOUND,
-        absl::StrCat(
-            "collection '", request->collection(), "' has no model '", request->model_id(), "'"));
+  MESHSEEK_ASSIGN_OR_RETURN(const std::optional<std::string> stored,
+                            store_->ModelMesh({plan.parts.front().name, request.model_id()}));
+  if (!stored.has_value()) {
+    return absl::NotFoundError(absl::StrCat(
+        "collection '", request.collection(), "' has no model '", request.model_id(), "'"));
   }
+  const std::string model = absl::StrCat("model ", request.model_id(), ": ");
   v1::MeshInput input;
-  if (!input.mutable_mesh()->ParseFromString(**stored)) {
-    return grpc::Status(
-        grpc::StatusCode::DATA_LOSS,
-        absl::StrCat("model ", request->model_id(), ": stored mesh does not parse"));
+  if (!input.mutable_mesh()->ParseFromString(*stored)) {
+    return absl::DataLossError(model + "stored mesh does not parse");
   }
-  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(input, options_.mesh_limits);
-  if (!mesh.ok()) return rpc::ToGrpcStatus(mesh.status());
-  absl::StatusOr<std::string> drawn = RenderThumbnailPng(*mesh);
+  MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh,
+                            rpc::MeshFromProto(input, options_.mesh_limits));
+  absl::StatusOr<std::string> drawn = RenderThumbnailPng(mesh);
   if (!drawn.ok()) {
-    return grpc::Status(
-        grpc::StatusCode::FAILED_PRECONDITION,
-        absl::StrCat(
-            "model ", request->model_id(), ": no thumbnail (", drawn.status().message(), ")"));
+    return absl::FailedPreconditionError(
+        absl::StrCat(model, "no thumbnail (", drawn.status().message(), ")"));
   }
-  if (absl::Status s = store_->SetThumbnail(key, *drawn); !s.ok()) return rpc::ToGrpcStatus(s);
-  response->set_png(*std::move(drawn));
-  return grpc::Status::OK;
+  MESHSEEK_RETURN_IF_ERROR(store_->SetThumbnail(key, *drawn));
+  response.set_png(*std::move(drawn));
+  return response;
 }
 
-grpc::Status CoordinatorService::ListModels(grpc::ServerContext*,
-                                            const v1::ListCollectionModelsRequest* request,
-                                            v1::ListCollectionModelsResponse* response) {
-  absl::StatusOr<CollectionPlan> plan = PublicPlan(request->collection());
-  if (!plan.ok()) return rpc::ToGrpcStatus(plan.status());
-  absl::StatusOr<v1::ListCollectionModelsResponse> models =
-      store_->ListModels(*request, plan->fused() ? plan->PartNames() : std::vector<std::string>());
-  if (!models.ok()) return rpc::ToGrpcStatus(models.status());
-  *response = *std::move(models);
-  return grpc::Status::OK;
+absl::StatusOr<v1::ListCollectionModelsResponse> CoordinatorService::ListModels(
+    const v1::ListCollectionModelsRequest& request, const rpc::CallContext&) {
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionPlan plan, PublicPlan(request.collection()));
+  return store_->ListModels(request, plan.fused() ? plan.PartNames() : std::vector<std::string>());
 }
 
 // ----------------------------------------------------------------------- jobs
 
-grpc::Status CoordinatorService::GetJob(grpc::ServerContext*,
-                                        const v1::JobRequest* request,
-                                        v1::JobStatus* response) {
-  absl::StatusOr<v1::JobStatus> status = store_->GetJob(request->job_id());
-  if (!status.ok()) return rpc::ToGrpcStatus(status.status());
-  *response = *std::move(status);
-  return grpc::Status::OK;
+absl::StatusOr<v1::JobStatus> CoordinatorService::GetJob(const v1::JobRequest& request,
+                                                         const rpc::CallContext&) {
+  return store_->GetJob(request.job_id());
 }
 
-grpc::Status CoordinatorService::WatchJob(grpc::ServerContext* context,
-                                          const v1::JobRequest* request,
-                                          grpc::ServerWriter<v1::JobStatus>* writer) {
+absl::Status CoordinatorService::WatchJob(const v1::JobRequest& request,
+                                          rpc::Writer<v1::JobStatus> write,
+                                          const rpc::CallContext& call) {
   std::string last;
-  while (!context->IsCancelled() && !stop_) {
-    absl::StatusOr<v1::JobStatus> status = store_->GetJob(request->job_id());
-    if (!status.ok()) return rpc::ToGrpcStatus(status.status());
-    const std::string now = status->SerializeAsString();
-    if (now != last && !writer->Write(*status)) return grpc::Status::CANCELLED;
+  while (!call.cancelled() && !stop_) {
+    MESHSEEK_ASSIGN_OR_RETURN(const v1::JobStatus status, store_->GetJob(request.job_id()));
+    const std::string now = status.SerializeAsString();
+    if (now != last && !write(status)) return absl::CancelledError("");
     last = now;
-    if (status->state() != v1::JOB_STATE_RUNNING) return grpc::Status::OK;
+    if (status.state() != v1::JOB_STATE_RUNNING) return absl::OkStatus();
     absl::SleepFor(absl::Milliseconds(200));
   }
-  return grpc::Status(grpc::StatusCode::CANCELLED, "watch ended: the coordinator is stopping");
+  return absl::CancelledError("watch ended: the coordinator is stopping");
 }
 
 // --------------------------------------------------------------------- ingest
@@ -325,90 +285,74 @@ absl::StatusOr<v1::IngestAck> CoordinatorService::AcceptModel(const v1::IngestRe
   return ack;
 }
 
-grpc::Status CoordinatorService::Ingest(
-    grpc::ServerContext* context,
-    grpc::ServerReaderWriter<v1::IngestAck, v1::IngestRequest>* stream) {
+absl::Status CoordinatorService::Ingest(rpc::Reader<v1::IngestRequest> read,
+                                        rpc::Writer<v1::IngestAck> write,
+                                        const rpc::CallContext& call) {
   std::string job_id;
   std::string collection;
   std::vector<std::string> parts;  // where its models are stored
   v1::IngestRequest request;
-  grpc::Status result = grpc::Status::OK;
-  while (stream->Read(&request)) {
+  absl::Status result;
+  while (read(&request)) {
     if (job_id.empty()) {
-      absl::StatusOr<CollectionPlan> plan = PublicPlan(request.collection());
-      if (!plan.ok()) return rpc::ToGrpcStatus(plan.status());
-      parts = plan->PartNames();
-      absl::StatusOr<std::string> job = store_->NewJob("ingest", request.collection(), 0);
-      if (!job.ok()) return rpc::ToGrpcStatus(job.status());
-      job_id = *job;
+      MESHSEEK_ASSIGN_OR_RETURN(const CollectionPlan plan, PublicPlan(request.collection()));
+      parts = plan.PartNames();
+      MESHSEEK_ASSIGN_OR_RETURN(job_id, store_->NewJob("ingest", request.collection(), 0));
       collection = request.collection();
     } else if (request.collection() != collection) {
-      result = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                            absl::StrCat("model ", request.model_id(), ": an ingest stream is for "
-                                         "one collection ('", collection, "'), not '",
-                                         request.collection(), "'"));
+      result = absl::InvalidArgumentError(absl::StrCat(
+          "model ", request.model_id(), ": an ingest stream is for one collection ('", collection,
+          "'), not '", request.collection(), "'"));
       break;
     }
     // Backpressure: hold the acknowledgement while too much work waits.
-    if (!dispatcher_.WaitForRoom([context] { return context->IsCancelled(); })) {
-      result = grpc::Status(grpc::StatusCode::CANCELLED, "ingest cancelled");
+    if (!dispatcher_.WaitForRoom([&call] { return call.cancelled(); })) {
+      result = absl::CancelledError("ingest cancelled");
       break;
     }
     absl::StatusOr<v1::IngestAck> ack = AcceptModel(request, parts, job_id);
     if (!ack.ok()) {
-      result = rpc::ToGrpcStatus(ack.status());
+      result = ack.status();
       break;
     }
-    if (!stream->Write(*ack)) {
-      result = grpc::Status(grpc::StatusCode::CANCELLED, "ingest stream closed by the client");
+    if (!write(*ack)) {
+      result = absl::CancelledError("ingest stream closed by the client");
       break;
     }
   }
   if (!job_id.empty()) {
-    if (absl::Status s = store_->CloseIngestStream(job_id); !s.ok() && result.ok()) {
-      result = rpc::ToGrpcStatus(s);
-    }
+    if (absl::Status s = store_->CloseIngestStream(job_id); !s.ok() && result.ok()) result = s;
   }
   return result;
 }
 
 // ---------------------------------------------------------------------- build
 
-grpc::Status CoordinatorService::Build(grpc::ServerContext*,
-                                       const v1::BuildRequest* request,
-                                       v1::JobStatus* response) {
-  absl::StatusOr<std::string> job = builds_.Start(request->collection());
-  if (!job.ok()) return rpc::ToGrpcStatus(job.status());
-  v1::JobRequest get;
-  get.set_job_id(*job);
-  return GetJob(nullptr, &get, response);
+absl::StatusOr<v1::JobStatus> CoordinatorService::Build(const v1::BuildRequest& request,
+                                                        const rpc::CallContext&) {
+  MESHSEEK_ASSIGN_OR_RETURN(const std::string job, builds_.Start(request.collection()));
+  return store_->GetJob(job);
 }
 
 // ------------------------------------------------------- query, remove, eval
 
-grpc::Status CoordinatorService::RemoveModel(grpc::ServerContext*,
-                                             const v1::RemoveModelFromCollectionRequest* request,
-                                             v1::RemoveModelFromCollectionResponse* response) {
-  absl::StatusOr<CollectionPlan> plan = PublicPlan(request->collection());
-  if (!plan.ok()) return rpc::ToGrpcStatus(plan.status());
+absl::StatusOr<v1::RemoveModelFromCollectionResponse> CoordinatorService::RemoveModel(
+    const v1::RemoveModelFromCollectionRequest& request, const rpc::CallContext&) {
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionPlan plan, PublicPlan(request.collection()));
   bool removed = false;
-  for (const std::string& part : plan->PartNames()) {
+  for (const std::string& part : plan.PartNames()) {
     // The index first: a failure there leaves the model in both, and the
     // removal can simply be retried.
-    absl::StatusOr<bool> unindexed = workers_.index()->Remove(part, request->model_id());
-    if (!unindexed.ok()) return rpc::ToGrpcStatus(unindexed.status());
-    absl::StatusOr<std::optional<ModelState>> state =
-        store_->RemoveModel({part, request->model_id()});
-    if (!state.ok()) return rpc::ToGrpcStatus(state.status());
-    if (*state == ModelState::kPending) dispatcher_.PendingModelRemoved();
-    removed = removed || state->has_value();
+    MESHSEEK_RETURN_IF_ERROR(workers_.index()->Remove(part, request.model_id()).status());
+    MESHSEEK_ASSIGN_OR_RETURN(const std::optional<ModelState> state,
+                              store_->RemoveModel({part, request.model_id()}));
+    if (state == ModelState::kPending) dispatcher_.PendingModelRemoved();
+    removed = removed || state.has_value();
   }
-  if (absl::Status s = store_->RemoveThumbnail({request->collection(), request->model_id()});
-      !s.ok()) {
-    return rpc::ToGrpcStatus(s);
-  }
-  response->set_removed(removed);
-  return grpc::Status::OK;
+  MESHSEEK_RETURN_IF_ERROR(store_->RemoveThumbnail({request.collection(), request.model_id()}));
+  v1::RemoveModelFromCollectionResponse response;
+  response.set_removed(removed);
+  return response;
 }
 
 }  // namespace meshseek

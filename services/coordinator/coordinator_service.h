@@ -46,6 +46,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
+#include "common/rpc/handler.h"
 #include "common/rpc/metrics.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"
 #include "services/coordinator/build_runner.h"
@@ -67,41 +68,61 @@ class CoordinatorService final : public v1::Coordinator::Service {
   /// Stops the dispatchers and build jobs (after the server has shut down).
   void Stop();
 
-  grpc::Status CreateCollection(grpc::ServerContext* context,
-                                const v1::CreateCollectionRequest* request,
-                                v1::Collection* response) override;
-  grpc::Status GetCollection(grpc::ServerContext* context,
-                             const v1::GetCollectionRequest* request,
-                             v1::Collection* response) override;
+  absl::StatusOr<v1::Collection> CreateCollection(const v1::CreateCollectionRequest& request, const rpc::CallContext& call);
+  absl::StatusOr<v1::Collection> GetCollection(const v1::GetCollectionRequest& request, const rpc::CallContext& call);
+  absl::Status Ingest(rpc::Reader<v1::IngestRequest> read, rpc::Writer<v1::IngestAck> write, const rpc::CallContext& call);
+  absl::StatusOr<v1::JobStatus> Build(const v1::BuildRequest& request, const rpc::CallContext& call);
+  absl::StatusOr<v1::JobStatus> GetJob(const v1::JobRequest& request, const rpc::CallContext& call);
+  absl::Status WatchJob(const v1::JobRequest& request, rpc::Writer<v1::JobStatus> write, const rpc::CallContext& call);
+  absl::StatusOr<v1::QueryResponse> Query(const v1::QueryRequest& request, const rpc::CallContext& call);
+  absl::StatusOr<v1::RemoveModelFromCollectionResponse> RemoveModel(const v1::RemoveModelFromCollectionRequest& request, const rpc::CallContext& call);
+  absl::StatusOr<v1::ListCollectionModelsResponse> ListModels(const v1::ListCollectionModelsRequest& request, const rpc::CallContext& call);
+  absl::StatusOr<v1::ListCollectionsResponse> ListCollections(const v1::ListCollectionsRequest& request, const rpc::CallContext& call);
+  absl::StatusOr<v1::Thumbnail> GetThumbnail(const v1::GetThumbnailRequest& request, const rpc::CallContext& call);
+  absl::Status Evaluate(const v1::EvaluateRequest& request, rpc::Writer<v1::EvaluateRow> write, const rpc::CallContext& call);
+
+  // gRPC entry points (common/rpc/handler.h).
+  grpc::Status CreateCollection(grpc::ServerContext* context, const v1::CreateCollectionRequest* request, v1::Collection* response) override {
+    return rpc::Serve(context, request, response, this, &CoordinatorService::CreateCollection);
+  }
+  grpc::Status GetCollection(grpc::ServerContext* context, const v1::GetCollectionRequest* request, v1::Collection* response) override {
+    return rpc::Serve(context, request, response, this, &CoordinatorService::GetCollection);
+  }
   grpc::Status Ingest(grpc::ServerContext* context,
-                      grpc::ServerReaderWriter<v1::IngestAck, v1::IngestRequest>* stream) override;
-  grpc::Status Build(grpc::ServerContext* context,
-                     const v1::BuildRequest* request,
-                     v1::JobStatus* response) override;
-  grpc::Status GetJob(grpc::ServerContext* context,
-                      const v1::JobRequest* request,
-                      v1::JobStatus* response) override;
+                      grpc::ServerReaderWriter<v1::IngestAck, v1::IngestRequest>* stream) override {
+    return rpc::Serve(context, stream, this, &CoordinatorService::Ingest);
+  }
+  grpc::Status Build(grpc::ServerContext* context, const v1::BuildRequest* request, v1::JobStatus* response) override {
+    return rpc::Serve(context, request, response, this, &CoordinatorService::Build);
+  }
+  grpc::Status GetJob(grpc::ServerContext* context, const v1::JobRequest* request, v1::JobStatus* response) override {
+    return rpc::Serve(context, request, response, this, &CoordinatorService::GetJob);
+  }
   grpc::Status WatchJob(grpc::ServerContext* context,
-                        const v1::JobRequest* request,
-                        grpc::ServerWriter<v1::JobStatus>* writer) override;
-  grpc::Status Query(grpc::ServerContext* context,
-                     const v1::QueryRequest* request,
-                     v1::QueryResponse* response) override;
-  grpc::Status RemoveModel(grpc::ServerContext* context,
-                           const v1::RemoveModelFromCollectionRequest* request,
-                           v1::RemoveModelFromCollectionResponse* response) override;
-  grpc::Status ListModels(grpc::ServerContext* context,
-                          const v1::ListCollectionModelsRequest* request,
-                          v1::ListCollectionModelsResponse* response) override;
-  grpc::Status ListCollections(grpc::ServerContext* context,
-                               const v1::ListCollectionsRequest* request,
-                               v1::ListCollectionsResponse* response) override;
-  grpc::Status GetThumbnail(grpc::ServerContext* context,
-                            const v1::GetThumbnailRequest* request,
-                            v1::Thumbnail* response) override;
+                      const v1::JobRequest* request,
+                      grpc::ServerWriter<v1::JobStatus>* writer) override {
+    return rpc::Serve(context, request, writer, this, &CoordinatorService::WatchJob);
+  }
+  grpc::Status Query(grpc::ServerContext* context, const v1::QueryRequest* request, v1::QueryResponse* response) override {
+    return rpc::Serve(context, request, response, this, &CoordinatorService::Query);
+  }
+  grpc::Status RemoveModel(grpc::ServerContext* context, const v1::RemoveModelFromCollectionRequest* request, v1::RemoveModelFromCollectionResponse* response) override {
+    return rpc::Serve(context, request, response, this, &CoordinatorService::RemoveModel);
+  }
+  grpc::Status ListModels(grpc::ServerContext* context, const v1::ListCollectionModelsRequest* request, v1::ListCollectionModelsResponse* response) override {
+    return rpc::Serve(context, request, response, this, &CoordinatorService::ListModels);
+  }
+  grpc::Status ListCollections(grpc::ServerContext* context, const v1::ListCollectionsRequest* request, v1::ListCollectionsResponse* response) override {
+    return rpc::Serve(context, request, response, this, &CoordinatorService::ListCollections);
+  }
+  grpc::Status GetThumbnail(grpc::ServerContext* context, const v1::GetThumbnailRequest* request, v1::Thumbnail* response) override {
+    return rpc::Serve(context, request, response, this, &CoordinatorService::GetThumbnail);
+  }
   grpc::Status Evaluate(grpc::ServerContext* context,
-                        const v1::EvaluateRequest* request,
-                        grpc::ServerWriter<v1::EvaluateRow>* writer) override;
+                      const v1::EvaluateRequest* request,
+                      grpc::ServerWriter<v1::EvaluateRow>* writer) override {
+    return rpc::Serve(context, request, writer, this, &CoordinatorService::Evaluate);
+  }
 
  private:
   CoordinatorService(const CoordinatorOptions& options, std::unique_ptr<CoordinatorStore> store);
@@ -110,6 +131,13 @@ class CoordinatorService final : public v1::Coordinator::Service {
   // The plan of a collection clients may use: InvalidArgument for a member.
   absl::StatusOr<CollectionPlan> PublicPlan(const std::string& name);
   // Ingest of one model: validates, stores, returns the ack.
+  // Query: the query's mesh (given, or a stored model's) as arrays, and
+  // each part's signature of it (the parts extracted in parallel), with the
+  // number of local features they found.
+  absl::StatusOr<v1::Mesh> QueryMesh(const v1::QueryRequest& request, const CollectionPlan& plan);
+  absl::StatusOr<std::vector<IndexSignature>> QuerySignatures(const v1::Mesh& mesh,
+                                                              const CollectionPlan& plan,
+                                                              uint32_t* features);
   absl::StatusOr<v1::IngestAck> AcceptModel(const v1::IngestRequest& request,
                                             const std::vector<std::string>& parts,
                                             const std::string& job_id);

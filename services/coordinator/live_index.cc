@@ -10,10 +10,6 @@
 namespace meshseek {
 namespace {
 
-absl::Status Prefixed(const absl::Status& status, const std::string& prefix) {
-  return absl::Status(status.code(), absl::StrCat(prefix, status.message()));
-}
-
 // The collection clients name for a part: a member's fused collection, or
 // the collection itself.
 std::string PublicName(const std::string& collection) {

@@ -7,9 +7,9 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "common/base/status_macros.h"
 #include "common/features/local_feature_extractor.h"
 #include "common/rpc/convert.h"
-#include "common/rpc/status.h"
 
 namespace meshseek {
 
@@ -25,33 +25,29 @@ ExtractService::ExtractService(const ExtractServiceOptions& options)
                                    : std::max(1u, std::thread::hardware_concurrency())),
       mesh_limits_(options.mesh_limits) {}
 
-grpc::Status ExtractService::Extract(grpc::ServerContext* context,
-                                     const v1::ExtractRequest* request,
-                                     v1::ExtractResponse* response) {
+absl::StatusOr<v1::ExtractResponse> ExtractService::Extract(const v1::ExtractRequest& request,
+                                                            const rpc::CallContext& call) {
+  // Every error names the model it is about.
   const std::string where =
-      request->model_id().empty() ? "" : absl::StrCat("model ", request->model_id(), ": ");
-  auto fail = [&](const absl::Status& status) {
-    return rpc::ToGrpcStatus(absl::Status(status.code(), absl::StrCat(where, status.message())));
-  };
+      request.model_id().empty() ? "" : absl::StrCat("model ", request.model_id(), ": ");
+  auto fail = [&where](const absl::Status& status) { return Prefixed(status, where); };
   // Parse and check everything before taking a slot.
   absl::StatusOr<RetrievalPipelineOptions> options =
-      rpc::PipelineOptionsFromParams(request->params());
+      rpc::PipelineOptionsFromParams(request.params());
   if (!options.ok()) return fail(options.status());
-  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request->mesh(), mesh_limits_);
+  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request.mesh(), mesh_limits_);
   if (!mesh.ok()) return fail(mesh.status());
   std::optional<PointGraph> graph;
-  if (request->has_resampled() && options->extractor.method == FeatureMethod::kRldSift) {
-    absl::StatusOr<PointGraph> parsed = rpc::GraphFromProto(request->resampled());
+  if (request.has_resampled() && options->extractor.method == FeatureMethod::kRldSift) {
+    absl::StatusOr<PointGraph> parsed = rpc::GraphFromProto(request.resampled());
     if (!parsed.ok()) return fail(parsed.status());
     graph = *std::move(parsed);
   }
   {
     absl::MutexLock lock(&mutex_);
-    const absl::Time deadline = absl::FromChrono(context->deadline());
     auto free_slot = [this]() ABSL_SHARED_LOCKS_REQUIRED(mutex_) { return busy_ < workers_; };
-    if (!mutex_.AwaitWithDeadline(absl::Condition(&free_slot), deadline)) {
-      return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED,
-                          absl::StrCat(where, "no extraction slot before the deadline"));
+    if (!mutex_.AwaitWithDeadline(absl::Condition(&free_slot), call.deadline())) {
+      return fail(absl::DeadlineExceededError("no extraction slot before the deadline"));
     }
     ++busy_;
   }
@@ -62,8 +58,9 @@ grpc::Status ExtractService::Extract(grpc::ServerContext* context,
     --busy_;
   }
   if (!features.ok()) return fail(features.status());
-  rpc::FeaturesToProto(*features, response->mutable_features());
-  return grpc::Status::OK;
+  v1::ExtractResponse response;
+  rpc::FeaturesToProto(*features, response.mutable_features());
+  return response;
 }
 
 }  // namespace meshseek

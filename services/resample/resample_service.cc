@@ -3,24 +3,23 @@
 #include "absl/strings/str_cat.h"
 #include "common/features/rld_sift.h"
 #include "common/rpc/convert.h"
-#include "common/rpc/status.h"
+#include "common/base/status_macros.h"
 
 namespace meshseek {
 
-grpc::Status ResampleService::Resample(grpc::ServerContext*,
-                                       const v1::ResampleRequest* request,
-                                       v1::ResampleResponse* response) {
+absl::StatusOr<v1::ResampleResponse> ResampleService::Resample(
+    const v1::ResampleRequest& request, const rpc::CallContext&) {
   RldSiftOptions limits;  // validates the two parameters as RLD-SIFT does
-  limits.num_samples = request->num_samples();
-  limits.neighbors = request->neighbors();
-  if (absl::Status valid = limits.Validate(); !valid.ok()) return rpc::ToGrpcStatus(valid);
-  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request->mesh(), mesh_limits_);
-  if (!mesh.ok()) return rpc::ToGrpcStatus(mesh.status());
-  absl::StatusOr<PointGraph> graph =
-      ResampleSurfaceGraph(*mesh, request->num_samples(), request->neighbors());
-  if (!graph.ok()) return rpc::ToGrpcStatus(graph.status());
-  rpc::GraphToProto(*graph, response->mutable_graph());
-  return grpc::Status::OK;
+  limits.num_samples = request.num_samples();
+  limits.neighbors = request.neighbors();
+  MESHSEEK_RETURN_IF_ERROR(limits.Validate());
+  MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh, rpc::MeshFromProto(request.mesh(), mesh_limits_));
+  MESHSEEK_ASSIGN_OR_RETURN(
+      const PointGraph graph,
+      ResampleSurfaceGraph(mesh, request.num_samples(), request.neighbors()));
+  v1::ResampleResponse response;
+  rpc::GraphToProto(graph, response.mutable_graph());
+  return response;
 }
 
 }  // namespace meshseek

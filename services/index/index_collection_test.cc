@@ -1,0 +1,115 @@
+// IndexCollection: the first model chooses the engine; later ones must fit
+// it (the only one may replace itself with another kind); answers come in
+// (ordinal, model id) order whatever the arrival order, over either engine.
+#include "services/index/index_collection.h"
+
+#include <string>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace meshseek {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+ModelSignature Histogram(uint32_t vocabulary, std::vector<uint32_t> words) {
+  ModelSignature signature;
+  signature.histogram.vocabulary = vocabulary;
+  signature.histogram.words = std::move(words);
+  signature.histogram.weights.assign(signature.histogram.words.size(),
+                                     1.0f / signature.histogram.words.size());
+  return signature;
+}
+
+ModelSignature Descriptor(char fill) {
+  ModelSignature signature;
+  signature.descriptor.emplace();
+  signature.descriptor->set_method("lfd");
+  signature.descriptor->set_data(
+      std::string(FeatureMethodInfoOf(FeatureMethod::kLfd).descriptor_bytes, fill));
+  return signature;
+}
+
+TEST(IndexCollectionTest, FirstModelChoosesAndOthersMustFit) {
+  IndexCollection collection;
+  ASSERT_TRUE(collection.Place("a", 0, "x", Histogram(8, {1, 2})).ok());
+  EXPECT_THAT(collection.CheckFits("b", Histogram(16, {1})).message(), HasSubstr("size 16"));
+  EXPECT_THAT(collection.CheckFits("b", Descriptor(1)).message(),
+              HasSubstr("the collection holds histograms"));
+  EXPECT_EQ(collection.Place("b", 1, "x", Descriptor(1)).code(), absl::StatusCode::kInvalidArgument);
+  // The only model may replace itself with another kind.
+  ASSERT_TRUE(collection.Place("a", 0, "x", Descriptor(1)).ok());
+  EXPECT_EQ(collection.size(), 1u);
+  EXPECT_FALSE(collection.epsilon().has_value());
+  EXPECT_THAT(collection.CheckFits("b", Histogram(8, {1})).message(),
+              HasSubstr("the collection holds global descriptors"));
+}
+
+TEST(IndexCollectionTest, HistogramsInOrderAndRanked) {
+  IndexCollection collection;
+  ASSERT_TRUE(collection.Place("c", 2, "y", Histogram(8, {5, 6})).ok());
+  ASSERT_TRUE(collection.Place("a", 0, "x", Histogram(8, {1, 2})).ok());
+  ASSERT_TRUE(collection.Place("b", 1, "x", Histogram(8, {1, 3})).ok());
+  EXPECT_THAT(collection.ModelIds(), ElementsAre("a", "b", "c"));
+  absl::StatusOr<std::vector<IndexCollection::Hit>> hits =
+      collection.Search(Histogram(8, {1, 2}), 2, 0, 1);
+  ASSERT_TRUE(hits.ok()) << hits.status();
+  ASSERT_EQ(hits->size(), 2u);
+  EXPECT_EQ((*hits)[0].model->model_id, "a");
+  EXPECT_EQ((*hits)[0].distance, 0.0f);
+  EXPECT_EQ((*hits)[1].model->model_id, "b");
+
+  google::protobuf::RepeatedPtrField<std::string> subset;
+  subset.Add("c");
+  subset.Add("a");
+  subset.Add("a");
+  subset.Add("unknown");
+  v1::DistancesResponse response;
+  ASSERT_TRUE(collection.Distances({Histogram(8, {1, 2})}, subset, 1, &response).ok());
+  EXPECT_THAT(response.model_ids(), ElementsAre("a", "c"));
+  ASSERT_EQ(response.distances_size(), 2);
+  EXPECT_EQ(response.distances(0), 0.0f);
+  EXPECT_GT(response.distances(1), 0.0f);
+
+  EXPECT_TRUE(collection.Remove("a"));
+  EXPECT_FALSE(collection.Remove("a"));
+  const std::vector<v1::IndexedModel> exported = collection.Export();
+  ASSERT_EQ(exported.size(), 2u);
+  EXPECT_EQ(exported[0].model_id(), "b");
+  EXPECT_THAT(exported[0].histogram().bins(), ElementsAre(1, 3));
+}
+
+TEST(IndexCollectionTest, EpsilonChangeKeepsEveryModel) {
+  IndexCollection collection;
+  ASSERT_TRUE(collection.Place("a", 0, "", Histogram(8, {1})).ok());
+  ASSERT_TRUE(collection.Place("b", 1, "", Histogram(8, {2})).ok());
+  const float before = (*collection.Search(Histogram(8, {1}), 2, 0, 1))[1].distance;
+  ASSERT_TRUE(collection.SetEpsilon(1e-3).ok());
+  EXPECT_EQ(collection.epsilon(), 1e-3);
+  absl::StatusOr<std::vector<IndexCollection::Hit>> after =
+      collection.Search(Histogram(8, {1}), 2, 0, 1);
+  ASSERT_TRUE(after.ok());
+  ASSERT_EQ(after->size(), 2u);
+  EXPECT_LT((*after)[1].distance, before);  // a larger zero-bin value: a nearer stranger
+}
+
+TEST(IndexCollectionTest, DescriptorsExportedAndRefusedAsHistograms) {
+  IndexCollection collection;
+  ASSERT_TRUE(collection.Place("b", 1, "", Descriptor(2)).ok());
+  ASSERT_TRUE(collection.Place("a", 0, "", Descriptor(1)).ok());
+  const std::vector<v1::IndexedModel> exported = collection.Export();
+  ASSERT_EQ(exported.size(), 2u);
+  EXPECT_EQ(exported[0].model_id(), "a");
+  EXPECT_EQ(exported[0].global_descriptor().method(), "lfd");
+  v1::DistancesResponse response;
+  // An empty histogram is a stranger only to histograms.
+  const absl::Status refused =
+      collection.Distances({Histogram(8, {})}, {}, 1, &response);
+  EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(refused.message(), HasSubstr("query 0"));
+}
+
+}  // namespace
+}  // namespace meshseek
