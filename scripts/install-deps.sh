@@ -26,7 +26,7 @@ if [ "${1:-}" != "--build-only" ]; then
     python3-websocket                                # ... drives headless Chromium over the DevTools protocol
     openssl                                          # tests/security_test makes a throwaway CA (deploy/make-certs.sh)
     libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
-    libfaiss-dev libopenblas-dev                     # yardsticks of bench/codebook_benchmark (Faiss on OpenBLAS)
+    libfaiss-dev libopenblas-dev                     # HNSW candidates of the index (Faiss on OpenBLAS)
     clang llvm libclang-rt-14-dev                    # libFuzzer harnesses (tests/fuzz; the runtime and sanitizer headers are only recommended by clang), llvm-symbolizer
   )
 fi

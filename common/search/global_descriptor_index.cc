@@ -95,6 +95,12 @@ absl::StatusOr<std::vector<KlNeighbor>> GlobalDescriptorIndex::DistancesTo(
   return out;
 }
 
+absl::StatusOr<absl::Span<const uint8_t>> GlobalDescriptorIndex::Descriptor(uint32_t doc) const {
+  const auto it = slot_.find(doc);
+  if (it == slot_.end()) return absl::NotFoundError(absl::StrCat("model ", doc, " is not stored"));
+  return absl::MakeConstSpan(data_.data() + it->second * dimension_, dimension_);
+}
+
 absl::StatusOr<std::vector<KlNeighbor>> GlobalDescriptorIndex::Search(
     absl::Span<const uint8_t> query, std::size_t k, int num_threads) const {
   absl::StatusOr<std::vector<KlNeighbor>> all = Distances(query, num_threads);

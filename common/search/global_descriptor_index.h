@@ -50,6 +50,8 @@ class GlobalDescriptorIndex {
                                                  std::size_t k,
                                                  int num_threads) const;
 
+  /// The descriptor stored for `doc` (valid until the next write), or NotFound.
+  absl::StatusOr<absl::Span<const uint8_t>> Descriptor(uint32_t doc) const;
   void ForEach(const std::function<void(uint32_t doc, absl::Span<const uint8_t>)>& fn) const;
   std::size_t MemoryBytes() const;
 

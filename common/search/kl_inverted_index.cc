@@ -49,9 +49,8 @@ struct KlInvertedIndex::PreparedQuery {
   std::vector<float> weights;
   std::vector<float> g;  // float-rounded g(weight)
   double c = 0.0, e = 0.0, a = 0.0, big_g = 0.0;
-  // sum_k sqrt(x_k) P[word_k] and its squared norm.
+  // sum_k sqrt(x_k) P[word_k], once the index has an embedding.
   std::vector<float> embedding;
-  float embedding_norm = 0.0f;
   bool empty() const { return words.empty(); }
 };
 
@@ -89,10 +88,6 @@ struct KlInvertedIndex::Segment {
       forward_values.push_back(value);
     }
     forward_end.push_back(forward_words.size());
-    if (!q.embedding.empty()) {
-      embeddings.insert(embeddings.end(), q.embedding.begin(), q.embedding.end());
-      embedding_norms.push_back(q.embedding_norm);
-    }
     docs.push_back(doc);
     live.push_back(1);
     empty.push_back(q.empty() ? 1 : 0);
@@ -113,11 +108,6 @@ struct KlInvertedIndex::Segment {
     q.e = e[slot];
     q.a = a[slot];
     q.big_g = big_g[slot];
-    if (slot < embedding_norms.size()) {  // once the index has an embedding
-      const std::size_t d = KlInvertedIndex::kEmbeddingDimensions;
-      q.embedding.assign(embeddings.begin() + slot * d, embeddings.begin() + (slot + 1) * d);
-      q.embedding_norm = embedding_norms[slot];
-    }
     return q;
   }
 
@@ -128,9 +118,6 @@ struct KlInvertedIndex::Segment {
   std::vector<uint16_t> forward_words;
   std::vector<uint16_t> forward_values;
   std::vector<std::size_t> forward_end;
-  // Per slot, kEmbeddingDimensions floats and their squared norm.
-  std::vector<float> embeddings;
-  std::vector<float> embedding_norms;
   // The value dictionary: per value id its float-rounded g and the weight,
   // side by side so that a posting loads both at once.
   std::vector<Float2> values;
@@ -194,14 +181,14 @@ void KlInvertedIndex::Append(uint32_t doc, const PreparedQuery& q) {
   locations_[doc] =
       Location{static_cast<uint32_t>(segments_.size() - 1), static_cast<uint16_t>(seg.docs.size())};
   seg.Add(doc, q);
+  // Models without words have no distance to anything: never proposed.
+  if (candidates_.has_value() && !q.empty()) candidates_->Add(doc, q.embedding);
   if (!embedding_ && size() >= kEmbeddingFitModels) FitEmbedding();
 }
 
 void KlInvertedIndex::Embed(PreparedQuery* q) const {
   q->embedding.resize(kEmbeddingDimensions);
   embedding_->Embed(q->words, q->weights, q->embedding.data());
-  q->embedding_norm = 0.0f;
-  for (float v : q->embedding) q->embedding_norm += v * v;
 }
 
 void KlInvertedIndex::FitEmbedding() {
@@ -214,15 +201,13 @@ void KlInvertedIndex::FitEmbedding() {
       sample, vocabulary_, static_cast<int>(kEmbeddingDimensions), kEmbeddingSeed);
   if (!fitted.ok()) return;  // cannot happen for stored (valid) histograms: stay exact
   embedding_ = *std::move(fitted);
+  candidates_ = *CandidateIndex::Create(static_cast<int>(kEmbeddingDimensions));
   for (const auto& seg : segments_) {
-    seg->embeddings.assign(seg->docs.size() * kEmbeddingDimensions, 0.0f);
-    seg->embedding_norms.assign(seg->docs.size(), 0.0f);
     for (std::size_t slot = 0; slot < seg->docs.size(); ++slot) {
+      if (!seg->live[slot] || seg->empty[slot]) continue;
       PreparedQuery q = seg->Stored(slot);
       Embed(&q);
-      std::copy(q.embedding.begin(), q.embedding.end(),
-                seg->embeddings.begin() + slot * kEmbeddingDimensions);
-      seg->embedding_norms[slot] = q.embedding_norm;
+      candidates_->Add(seg->docs[slot], q.embedding);
     }
   }
 }
@@ -240,6 +225,7 @@ bool KlInvertedIndex::Remove(uint32_t doc) {
   if (it == locations_.end()) return false;
   const Location at = it->second;
   locations_.erase(it);
+  if (candidates_.has_value()) candidates_->Remove(doc);
   Segment& seg = *segments_[at.segment];
   seg.live[at.slot] = 0;
   ++seg.dead;
@@ -374,48 +360,11 @@ std::vector<KlNeighbor> KlInvertedIndex::AllDistances(const PreparedQuery& q,
 std::vector<KlNeighbor> KlInvertedIndex::RerankCandidates(const PreparedQuery& q,
                                                           std::size_t candidates,
                                                           int num_threads) const {
-  // 1. The embedding's nearest non-empty models, per segment then overall.
-  struct Proposal {
-    float distance;
-    uint32_t segment;
-    uint16_t slot;
-  };
-  const auto nearer = [](const Proposal& a, const Proposal& b) {
-    return std::tie(a.distance, a.segment, a.slot) < std::tie(b.distance, b.segment, b.slot);
-  };
-  const std::size_t d = kEmbeddingDimensions;
-  std::vector<std::vector<Proposal>> per_segment(segments_.size());
-  ParallelFor(segments_.size(), num_threads, [&](std::size_t s) {
-    const Segment& seg = *segments_[s];
-    std::vector<Proposal>& out = per_segment[s];
-    for (std::size_t slot = 0; slot < seg.docs.size(); ++slot) {
-      if (!seg.live[slot] || seg.empty[slot]) continue;
-      const float* e = &seg.embeddings[slot * d];
-      float dot[8] = {};
-      for (std::size_t j = 0; j < d; j += 8) {
-        for (std::size_t l = 0; l < 8; ++l) dot[l] += q.embedding[j + l] * e[j + l];
-      }
-      const float product = ((dot[0] + dot[1]) + (dot[2] + dot[3])) + ((dot[4] + dot[5]) + (dot[6] + dot[7]));
-      out.push_back({q.embedding_norm + seg.embedding_norms[slot] - 2.0f * product,
-                     static_cast<uint32_t>(s), static_cast<uint16_t>(slot)});
-    }
-    if (out.size() > candidates) {
-      std::nth_element(out.begin(), out.begin() + (candidates - 1), out.end(), nearer);
-      out.resize(candidates);
-    }
-  });
-  std::vector<Proposal> proposals;
-  for (const auto& part : per_segment) proposals.insert(proposals.end(), part.begin(), part.end());
-  if (proposals.size() > candidates) {
-    std::nth_element(proposals.begin(), proposals.begin() + (candidates - 1), proposals.end(),
-                     nearer);
-    proposals.resize(candidates);
-  }
-  // 2. Their exact distances from the forward index.
-  std::vector<Location> at(proposals.size());
-  for (std::size_t c = 0; c < proposals.size(); ++c) {
-    at[c] = {proposals[c].segment, proposals[c].slot};
-  }
+  // The candidate index's proposals (live, with words), then their exact
+  // distances from the forward index.
+  const std::vector<Candidate> proposed = candidates_->Nearest(q.embedding, candidates);
+  std::vector<Location> at(proposed.size());
+  for (std::size_t c = 0; c < proposed.size(); ++c) at[c] = locations_.at(proposed[c].doc);
   return ForwardDistances(q, at, num_threads);
 }
 
@@ -464,6 +413,17 @@ std::vector<KlNeighbor> KlInvertedIndex::ForwardDistances(const PreparedQuery& q
 absl::StatusOr<std::vector<KlNeighbor>> KlInvertedIndex::DistancesTo(
     const SparseHistogram& query, absl::Span<const uint32_t> docs, int num_threads) const {
   MESHSEEK_ASSIGN_OR_RETURN(const PreparedQuery q, Prepare(query, "query"));
+  return DistancesTo(q, docs, num_threads);
+}
+
+absl::StatusOr<std::vector<KlNeighbor>> KlInvertedIndex::DistancesFromStored(
+    uint32_t doc, absl::Span<const uint32_t> docs, int num_threads) const {
+  MESHSEEK_ASSIGN_OR_RETURN(const PreparedQuery q, StoredQuery(doc, /*embedded=*/false));
+  return DistancesTo(q, docs, num_threads);
+}
+
+absl::StatusOr<std::vector<KlNeighbor>> KlInvertedIndex::DistancesTo(
+    const PreparedQuery& q, absl::Span<const uint32_t> docs, int num_threads) const {
   std::vector<Location> at(docs.size());
   for (std::size_t i = 0; i < docs.size(); ++i) {
     const auto it = locations_.find(docs[i]);
@@ -481,10 +441,40 @@ absl::StatusOr<std::vector<KlNeighbor>> KlInvertedIndex::Search(const SparseHist
                                                                 std::size_t candidates) const {
   if (k == 0) return absl::InvalidArgumentError("search: k must be at least 1");
   MESHSEEK_ASSIGN_OR_RETURN(const PreparedQuery q, Prepare(query, "query"));
+  return Search(q, k, num_threads, candidates);
+}
+
+absl::StatusOr<std::vector<KlNeighbor>> KlInvertedIndex::SearchStored(uint32_t doc,
+                                                                      std::size_t k,
+                                                                      int num_threads,
+                                                                      std::size_t candidates) const {
+  if (k == 0) return absl::InvalidArgumentError("search: k must be at least 1");
+  MESHSEEK_ASSIGN_OR_RETURN(const PreparedQuery q, StoredQuery(doc, /*embedded=*/true));
+  return Search(q, k, num_threads, candidates);
+}
+
+absl::StatusOr<KlInvertedIndex::PreparedQuery> KlInvertedIndex::StoredQuery(uint32_t doc,
+                                                                            bool embedded) const {
+  const auto it = locations_.find(doc);
+  if (it == locations_.end()) {
+    return absl::NotFoundError(absl::StrCat("model ", doc, " is not in the index"));
+  }
+  PreparedQuery q = segments_[it->second.segment]->Stored(it->second.slot);
+  // The embedding the candidate index holds is the one Prepare computes.
+  if (embedded && candidates_.has_value() && !q.empty()) {
+    MESHSEEK_ASSIGN_OR_RETURN(q.embedding, candidates_->Vector(doc));
+  }
+  return q;
+}
+
+std::vector<KlNeighbor> KlInvertedIndex::Search(const PreparedQuery& q,
+                                                std::size_t k,
+                                                int num_threads,
+                                                std::size_t candidates) const {
   // Candidates only when they are fewer than the models and the query can
   // have finite distances; otherwise the exact scan is the answer.
   std::vector<KlNeighbor> all = candidates > 0 && candidates >= k && candidates < size() &&
-                                        embedding_ && !q.empty()
+                                        candidates_.has_value() && !q.empty()
                                     ? RerankCandidates(q, candidates, num_threads)
                                     : AllDistances(q, num_threads);
   if (all.size() > k) {
@@ -529,6 +519,7 @@ absl::StatusOr<std::vector<float>> KlInvertedIndex::DistanceMatrix(const std::ve
 std::size_t KlInvertedIndex::MemoryBytes() const {
   std::size_t bytes = sizeof(*this) +
                       (embedding_ ? vocabulary_ * kEmbeddingDimensions * sizeof(float) : 0) +
+                      (candidates_.has_value() ? candidates_->MemoryBytes() : 0) +
                       locations_.capacity() * (sizeof(uint32_t) + sizeof(Location) + 1);
   for (const auto& seg : segments_) {
     bytes += sizeof(Segment) + seg->postings.capacity() * sizeof(Segment::Postings);
@@ -536,8 +527,7 @@ std::size_t KlInvertedIndex::MemoryBytes() const {
       bytes += (p.slots.capacity() + p.values.capacity()) * sizeof(uint16_t);
     }
     bytes += (seg->forward_words.capacity() + seg->forward_values.capacity()) * sizeof(uint16_t) +
-             seg->forward_end.capacity() * sizeof(std::size_t) +
-             (seg->embeddings.capacity() + seg->embedding_norms.capacity()) * sizeof(float);
+             seg->forward_end.capacity() * sizeof(std::size_t);
     bytes += seg->values.capacity() * sizeof(Float2) +
              seg->value_ids.capacity() * (sizeof(uint32_t) + sizeof(uint16_t) + 1);
     bytes += seg->docs.capacity() * sizeof(uint32_t) + seg->live.capacity() + seg->empty.capacity() +

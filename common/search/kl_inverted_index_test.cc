@@ -252,6 +252,41 @@ TEST(KlInvertedIndexTest, CandidatesAreReRankedWithExactDistancesAndFindTheNeare
   }
 }
 
+TEST(KlInvertedIndexTest, StoredModelsAsQueriesGiveTheirHistogramsAnswersBitForBit) {
+  // Past the fit (candidates from the graph) and with churn: a replaced
+  // model and a removed one.
+  const std::size_t n = KlInvertedIndex::kEmbeddingFitModels + 100;
+  const auto dense = CountHistograms(n + 1, 300, 1200, 5);
+  KlInvertedIndex index = MakeIndex(std::vector<std::vector<float>>(dense.begin(), dense.begin() + n));
+  ASSERT_TRUE(index.has_embedding());
+  ASSERT_TRUE(index.Upsert(7, SparseFromDense(dense[n])).ok());
+  ASSERT_TRUE(index.Remove(9));
+  for (uint32_t doc : {0u, 7u, 1000u, static_cast<uint32_t>(n - 1)}) {
+    const SparseHistogram histogram = *index.Histogram(doc);
+    for (std::size_t candidates : {std::size_t{0}, std::size_t{50}}) {
+      const auto given = index.Search(histogram, 20, 1, candidates);
+      const auto stored = index.SearchStored(doc, 20, 1, candidates);
+      ASSERT_TRUE(given.ok() && stored.ok()) << stored.status();
+      ASSERT_EQ(given->size(), stored->size());
+      EXPECT_EQ((*stored)[0].doc, doc);
+      for (std::size_t i = 0; i < given->size(); ++i) {
+        EXPECT_EQ((*given)[i].doc, (*stored)[i].doc);
+        EXPECT_EQ((*given)[i].distance, (*stored)[i].distance);
+      }
+    }
+    const std::vector<uint32_t> docs = {3, doc, 2000, 7};
+    const auto given = index.DistancesTo(histogram, docs, 1);
+    const auto stored = index.DistancesFromStored(doc, docs, 1);
+    ASSERT_TRUE(given.ok() && stored.ok());
+    for (std::size_t i = 0; i < docs.size(); ++i) {
+      EXPECT_EQ((*given)[i].distance, (*stored)[i].distance);
+    }
+  }
+  EXPECT_EQ(index.SearchStored(9, 5, 1).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(index.DistancesFromStored(9, std::vector<uint32_t>{0}, 1).status().code(),
+            absl::StatusCode::kNotFound);
+}
+
 TEST(KlInvertedIndexTest, CandidatesBeforeTheEmbeddingIsFittedSearchExactly) {
   const auto dense = CountHistograms(300, 200, 600, 22);
   const KlInvertedIndex index = MakeIndex(dense);

@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
+#include "common/features/local_feature_extractor.h"
 #include "common/search/fusion.h"
 
 namespace meshseek {
@@ -108,6 +109,76 @@ absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> CandidatePartDista
   return PartDistances(index, plan, signatures, &ids);
 }
 
+namespace {
+
+// One part's lists of a batch of rows: per row, the models and distances.
+using BatchLists = std::vector<std::vector<IndexShards::Scored>>;
+
+// Each row's union of the proposing parts' lists, as nodes in increasing
+// order (a model added since the export has no node: it waits for the next
+// build).
+std::vector<std::vector<uint32_t>> Unions(const std::vector<BatchLists>& lists,
+                                          const std::vector<bool>& proposes,
+                                          const IndexShards::PartModels& models,
+                                          std::size_t rows) {
+  std::vector<std::vector<uint32_t>> unions(rows);
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t p = 0; p < lists.size(); ++p) {
+      if (!proposes[p]) continue;
+      for (const IndexShards::Scored& s : lists[p][r]) {
+        const auto node = models.row_of.find(s.model_id);
+        if (node != models.row_of.end()) unions[r].push_back(static_cast<uint32_t>(node->second));
+      }
+    }
+    std::sort(unions[r].begin(), unions[r].end());
+    unions[r].erase(std::unique(unions[r].begin(), unions[r].end()), unions[r].end());
+  }
+  return unions;
+}
+
+// Writes the distances of `scored` into `row`, the distances to `row_union`.
+void Place(const std::vector<IndexShards::Scored>& scored,
+           const IndexShards::PartModels& models,
+           const std::vector<uint32_t>& row_union,
+           std::vector<float>* row,
+           std::vector<bool>* known) {
+  for (const IndexShards::Scored& s : scored) {
+    const auto node = models.row_of.find(s.model_id);
+    if (node == models.row_of.end()) continue;
+    const auto at = std::lower_bound(row_union.begin(), row_union.end(), node->second);
+    if (at == row_union.end() || *at != node->second) continue;
+    (*row)[at - row_union.begin()] = s.distance;
+    (*known)[at - row_union.begin()] = true;
+  }
+}
+
+// One part's distances from each row's model to its union: what its lists
+// hold, the rest in one PairDistances call.
+absl::StatusOr<std::vector<std::vector<float>>> UnionDistances(
+    IndexShards* index,
+    const IndexShards::Part& part,
+    const std::vector<std::string>& ids,
+    const BatchLists* lists,  // nullptr: the part did not propose
+    const std::vector<std::vector<uint32_t>>& unions,
+    const IndexShards::PartModels& models) {
+  std::vector<std::vector<float>> rows(ids.size());
+  std::vector<std::vector<bool>> known(ids.size());
+  std::vector<std::vector<std::string>> missing(ids.size());
+  for (std::size_t r = 0; r < ids.size(); ++r) {
+    rows[r].assign(unions[r].size(), std::numeric_limits<float>::infinity());
+    known[r].assign(unions[r].size(), false);
+    if (lists != nullptr) Place((*lists)[r], models, unions[r], &rows[r], &known[r]);
+    for (std::size_t j = 0; j < unions[r].size(); ++j) {
+      if (!known[r][j]) missing[r].push_back(models.models[0][unions[r][j]].model_id());
+    }
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(const BatchLists got, index->PairDistances(part, ids, missing));
+  for (std::size_t r = 0; r < ids.size(); ++r) Place(got[r], models, unions[r], &rows[r], &known[r]);
+  return rows;
+}
+
+}  // namespace
+
 absl::StatusOr<NeighborGraph> ApproximateNeighborGraph(IndexShards* index,
                                                        const CollectionPlan& plan,
                                                        const IndexShards::PartModels& models,
@@ -116,52 +187,50 @@ absl::StatusOr<NeighborGraph> ApproximateNeighborGraph(IndexShards* index,
                                                        const RankingGraphOptions& options) {
   const std::size_t n = models.size();
   const std::size_t parts = plan.parts.size();
+  std::vector<IndexShards::Part> index_parts;
+  // The parts that propose: the histogram ones (every part when none is).
+  std::vector<bool> proposes(parts);
+  bool any_histogram = false;
+  for (std::size_t p = 0; p < parts; ++p) {
+    index_parts.push_back({plan.parts[p].name, plan.parts[p].options.kl.epsilon});
+    proposes[p] = FeatureMethodInfoOf(plan.parts[p].options.extractor.method).kind !=
+                  DescriptorKind::kGlobal;
+    any_histogram |= proposes[p];
+  }
+  if (!any_histogram) proposes.assign(parts, true);
+  const uint32_t c = options.graph_candidates;
   MESHSEEK_ASSIGN_OR_RETURN(NeighborGraph graph, NeighborGraph::Create(n, k));
-  std::vector<absl::Status> errors(n);
-  ParallelFor(n, options.threads, [&](std::size_t i) {
-    std::vector<IndexSignature> own(parts);
-    std::vector<const IndexSignature*> signatures(parts);
-    for (std::size_t p = 0; p < parts; ++p) {
-      const v1::IndexedModel& m = *models.entry[p][i];
-      if (m.has_global_descriptor()) {
-        own[p].descriptor = m.global_descriptor();
-      } else {
-        own[p].histogram = m.histogram();
-      }
-      signatures[p] = &own[p];
-    }
-    absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> distances =
-        CandidatePartDistances(index, plan, signatures, options.graph_candidates);
-    if (!distances.ok()) {
-      errors[i] = distances.status();
-      return;
-    }
-    // Each part's distances as rows over the union (the nodes in the first
-    // part's answer order), fused with FuseRows' arithmetic.
-    std::vector<uint32_t> nodes;
-    absl::flat_hash_map<std::string, std::size_t> column;
-    for (const IndexShards::Scored& s : (*distances)[0]) {
-      const auto row = models.row_of.find(s.model_id);
-      if (row == models.row_of.end()) continue;  // added since the export
-      column[s.model_id] = nodes.size();
-      nodes.push_back(static_cast<uint32_t>(row->second));
-    }
-    std::vector<std::vector<float>> rows(
-        parts, std::vector<float>(nodes.size(), std::numeric_limits<float>::infinity()));
-    for (std::size_t p = 0; p < parts; ++p) {
-      for (const IndexShards::Scored& s : (*distances)[p]) {
-        const auto c = column.find(s.model_id);
-        if (c != column.end()) rows[p][c->second] = s.distance;
-      }
-    }
-    std::vector<absl::Span<const float>> spans(rows.begin(), rows.end());
-    std::vector<float> fused(nodes.size());
-    FuseRows(spans, factors, absl::MakeSpan(fused));
-    std::vector<GraphNeighbor> known(nodes.size());
-    for (std::size_t c = 0; c < nodes.size(); ++c) known[c] = {nodes[c], fused[c]};
-    graph.SetSparseRow(static_cast<uint32_t>(i), known);
-  });
-  for (const absl::Status& e : errors) MESHSEEK_RETURN_IF_ERROR(e);
+  for (std::size_t begin = 0; begin < n; begin += kGraphBatch) {
+    const std::size_t end = std::min(n, begin + kGraphBatch);
+    std::vector<std::string> ids;
+    for (std::size_t i = begin; i < end; ++i) ids.push_back(models.models[0][i].model_id());
+    // 1. Each proposing part's lists of the batch, one call a part.
+    std::vector<BatchLists> lists(parts);
+    MESHSEEK_RETURN_IF_ERROR(ForEachPart(parts, [&](std::size_t p) -> absl::Status {
+      if (!proposes[p]) return absl::OkStatus();
+      MESHSEEK_ASSIGN_OR_RETURN(lists[p], index->Neighbors(index_parts[p], ids, c, c));
+      return absl::OkStatus();
+    }));
+    // 2. Every part's distances to each row's union.
+    const std::vector<std::vector<uint32_t>> unions = Unions(lists, proposes, models, ids.size());
+    std::vector<std::vector<std::vector<float>>> rows(parts);
+    MESHSEEK_RETURN_IF_ERROR(ForEachPart(parts, [&](std::size_t p) -> absl::Status {
+      MESHSEEK_ASSIGN_OR_RETURN(rows[p], UnionDistances(index, index_parts[p], ids,
+                                                        proposes[p] ? &lists[p] : nullptr,
+                                                        unions, models));
+      return absl::OkStatus();
+    }));
+    // 3. Fused with FuseRows' arithmetic, each row's list from its union.
+    ParallelFor(ids.size(), options.threads, [&](std::size_t r) {
+      std::vector<absl::Span<const float>> spans(parts);
+      for (std::size_t p = 0; p < parts; ++p) spans[p] = rows[p][r];
+      std::vector<float> fused(unions[r].size());
+      FuseRows(spans, factors, absl::MakeSpan(fused));
+      std::vector<GraphNeighbor> known(unions[r].size());
+      for (std::size_t j = 0; j < unions[r].size(); ++j) known[j] = {unions[r][j], fused[j]};
+      graph.SetSparseRow(static_cast<uint32_t>(begin + r), known);
+    });
+  }
   return graph;
 }
 

@@ -23,6 +23,7 @@
 #ifndef MESHSEEK_SERVICES_COORDINATOR_FUSED_CANDIDATES_H_
 #define MESHSEEK_SERVICES_COORDINATOR_FUSED_CANDIDATES_H_
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -54,13 +55,22 @@ absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> CandidatePartDista
     const std::vector<const IndexSignature*>& signatures,
     uint32_t candidates);
 
+/// Rows of the approximate graph computed per round: each proposing part's
+/// lists of this many models in one Neighbors call, then each part's missing
+/// distances in one PairDistances call (about 1,024 x 150 distances).
+inline constexpr std::size_t kGraphBatch = 1024;
+
 /// The neighbour graph of the fused distances without all pairs
 /// (docs/design.md "Approximate neighbour graph"): node i's list from its
 /// fused distances to the union of every part's `graph_candidates` nearest
-/// to it, as CandidatePartDistances gives them for its own signatures, the
-/// rest of its row +inf (NeighborGraph::SetSparseRow). `models`: the parts'
-/// models (IndexShards::ExportParts), node i = row i; `factors`: the fusion
-/// factors of the build's scales. O(N x candidates) distances.
+/// to it (the histogram parts propose, as CandidatePartDistances), the rest
+/// of its row +inf (NeighborGraph::SetSparseRow). Computed where the
+/// signatures are: kGraphBatch rows at a time, one Neighbors call per
+/// proposing part, then one PairDistances call per part for what the union
+/// still needs; no RPC per model. `models`: the parts' models
+/// (IndexShards::ExportParts, signatures not needed), node i = row i;
+/// `factors`: the fusion factors of the build's scales. O(N x candidates)
+/// distances.
 absl::StatusOr<NeighborGraph> ApproximateNeighborGraph(IndexShards* index,
                                                        const CollectionPlan& plan,
                                                        const IndexShards::PartModels& models,

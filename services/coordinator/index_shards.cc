@@ -108,11 +108,9 @@ absl::StatusOr<std::vector<v1::ScoredModel>> IndexShards::Search(const v1::Searc
   return merged;
 }
 
-absl::StatusOr<std::vector<v1::IndexedModel>> IndexShards::Export(std::size_t s,
-                                                                  const std::string& collection) {
+absl::StatusOr<std::vector<v1::IndexedModel>> IndexShards::Export(
+    std::size_t s, const v1::ExportModelsRequest& request) {
   std::vector<v1::IndexedModel> models;
-  v1::ExportModelsRequest request;
-  request.set_collection(collection);
   const absl::Status status = rpc::RetryTransient(
       [&]() -> absl::Status {
         models.clear();
@@ -156,15 +154,19 @@ absl::StatusOr<std::vector<IndexShards::Scored>> IndexShards::QueryDistances(
   return all;
 }
 
-absl::StatusOr<IndexShards::PartModels> IndexShards::ExportParts(const std::vector<Part>& parts) {
+absl::StatusOr<IndexShards::PartModels> IndexShards::ExportParts(const std::vector<Part>& parts,
+                                                                 bool signatures) {
   // Every model of every part, from every shard; the first part's in
   // (ordinal, id) order gives the rows, the others must hold the same models.
   const std::size_t p_count = parts.size();
   PartModels out;
   out.models.resize(p_count);
   for (std::size_t p = 0; p < p_count; ++p) {
+    v1::ExportModelsRequest request;
+    request.set_collection(parts[p].collection);
+    request.set_without_signatures(!signatures);
     for (std::size_t s = 0; s < shards_.size(); ++s) {
-      MESHSEEK_ASSIGN_OR_RETURN(std::vector<v1::IndexedModel> part, Export(s, parts[p].collection));
+      MESHSEEK_ASSIGN_OR_RETURN(std::vector<v1::IndexedModel> part, Export(s, request));
       for (v1::IndexedModel& m : part) out.models[p].push_back(std::move(m));
     }
     if (out.models[p].empty()) {
@@ -206,9 +208,8 @@ absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
                                              const std::vector<std::size_t>* only_rows) {
   // 1. Every model of every part, in row order.
   const std::size_t p_count = parts.size();
-  MESHSEEK_ASSIGN_OR_RETURN(const PartModels exported, ExportParts(parts));
+  MESHSEEK_ASSIGN_OR_RETURN(const PartModels exported, ExportParts(parts, /*signatures=*/false));
   const std::vector<std::vector<v1::IndexedModel>>& models = exported.models;
-  const std::vector<std::vector<const v1::IndexedModel*>>& entry = exported.entry;
   const absl::flat_hash_map<std::string, std::size_t>& column = exported.row_of;
   const std::size_t n = exported.size();
 
@@ -229,12 +230,17 @@ absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
   std::vector<std::vector<float>> blocks(p_count);
   for (std::size_t begin = 0; begin < rows.size(); begin += kMatrixBatch) {
     const std::size_t end = std::min(rows.size(), begin + kMatrixBatch);
+    std::vector<std::string> ids;
+    for (std::size_t r = begin; r < end; ++r) ids.push_back(models[0][rows[r]].model_id());
     for (std::size_t p = 0; p < p_count; ++p) {
       v1::DistancesRequest request;
       request.set_collection(parts[p].collection);
       request.set_kl_epsilon(parts[p].kl_epsilon);
-      for (std::size_t r = begin; r < end; ++r) {
-        const v1::IndexedModel& m = *entry[p][rows[r]];
+      // The block's signatures, a block at a time: a large collection's
+      // histograms never sit in the coordinator's memory at once.
+      MESHSEEK_ASSIGN_OR_RETURN(const std::vector<v1::IndexedModel> block_models,
+                                Fetch(parts[p], ids));
+      for (const v1::IndexedModel& m : block_models) {
         if (m.has_global_descriptor()) {
           *request.add_global_queries() = m.global_descriptor();
         } else {
@@ -305,6 +311,165 @@ absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
     }
   }
   return absl::OkStatus();
+}
+
+absl::StatusOr<std::vector<std::vector<v1::QueryModel>>> IndexShards::QueriesPerShard(
+    const Part& part, const std::vector<std::string>& model_ids) {
+  std::vector<std::vector<v1::QueryModel>> queries(shards_.size(),
+                                                   std::vector<v1::QueryModel>(model_ids.size()));
+  for (std::vector<v1::QueryModel>& shard : queries) {
+    for (std::size_t i = 0; i < model_ids.size(); ++i) shard[i].set_model_id(model_ids[i]);
+  }
+  if (shards_.size() == 1) return queries;  // every model is held where it is asked
+  // Each model whole from its own shard, for the others.
+  MESHSEEK_ASSIGN_OR_RETURN(std::vector<v1::IndexedModel> whole, Fetch(part, model_ids));
+  for (std::size_t i = 0; i < model_ids.size(); ++i) {
+    for (std::size_t s = 0; s < shards_.size(); ++s) {
+      if (s != ShardOf(model_ids[i])) *queries[s][i].mutable_model() = whole[i];
+    }
+  }
+  return queries;
+}
+
+absl::StatusOr<std::vector<v1::IndexedModel>> IndexShards::Fetch(
+    const Part& part, const std::vector<std::string>& model_ids) {
+  std::vector<v1::ExportModelsRequest> requests(shards_.size());
+  for (v1::ExportModelsRequest& request : requests) request.set_collection(part.collection);
+  for (const std::string& id : model_ids) requests[ShardOf(id)].add_model_ids(id);
+  absl::flat_hash_map<std::string, v1::IndexedModel> found;
+  for (std::size_t s = 0; s < shards_.size(); ++s) {
+    if (requests[s].model_ids().empty()) continue;
+    MESHSEEK_ASSIGN_OR_RETURN(std::vector<v1::IndexedModel> got, Export(s, requests[s]));
+    for (v1::IndexedModel& m : got) found[m.model_id()] = std::move(m);
+  }
+  if (found.empty() && !model_ids.empty()) {
+    return absl::NotFoundError(
+        absl::StrCat("index has no models in collection '", part.collection, "'"));
+  }
+  std::vector<v1::IndexedModel> models(model_ids.size());
+  for (std::size_t i = 0; i < model_ids.size(); ++i) {
+    const auto it = found.find(model_ids[i]);
+    if (it == found.end()) {
+      return absl::AbortedError(absl::StrCat("model '", model_ids[i], "' of collection '",
+                                             part.collection,
+                                             "' was removed while its build ran; build again"));
+    }
+    models[i] = it->second;
+  }
+  return models;
+}
+
+namespace {
+
+// A shard's list as Scored, appended to `out`.
+void AppendScored(const v1::NeighborList& list, std::vector<IndexShards::Scored>* out) {
+  for (int j = 0; j < list.neighbor_ids_size() && j < list.distances_size(); ++j) {
+    out->push_back({list.neighbor_ids(j), list.distances(j)});
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> IndexShards::Neighbors(
+    const Part& part, const std::vector<std::string>& model_ids, uint32_t count,
+    uint32_t candidates) {
+  if (model_ids.size() > kMaxGraphBatch) {
+    return absl::InternalError(absl::StrCat(model_ids.size(), " neighbour queries in one call"));
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(std::vector<std::vector<v1::QueryModel>> queries,
+                            QueriesPerShard(part, model_ids));
+  std::vector<std::vector<Scored>> merged(model_ids.size());
+  std::size_t answered = 0;
+  for (std::size_t s = 0; s < shards_.size(); ++s) {
+    v1::NeighborsRequest request;
+    request.set_collection(part.collection);
+    request.set_kl_epsilon(part.kl_epsilon);
+    request.set_count(count);
+    request.set_candidates(candidates);
+    for (v1::QueryModel& q : queries[s]) *request.add_queries() = std::move(q);
+    std::vector<std::vector<Scored>> lists;
+    const absl::Status status = rpc::RetryTransient(
+        [&]() -> absl::Status {
+          lists.clear();
+          grpc::ClientContext context;
+          rpc::SetDeadline(&context, call_deadline_);
+          auto reader = shards_[s]->Neighbors(&context, request);
+          v1::NeighborLists batch;
+          while (reader->Read(&batch)) {
+            for (const v1::NeighborList& list : batch.lists()) AppendScored(list, &lists.emplace_back());
+          }
+          const grpc::Status done = reader->Finish();
+          return absl::Status(static_cast<absl::StatusCode>(done.error_code()),
+                              done.error_message());
+        },
+        retry_, stop_);
+    if (status.code() == absl::StatusCode::kNotFound && shards_.size() > 1) continue;
+    if (!status.ok()) {
+      return absl::Status(status.code(), absl::StrCat("index shard ", s, ": ", status.message()));
+    }
+    if (lists.size() != model_ids.size()) {
+      return absl::InternalError(absl::StrCat("index shard ", s, " answered ", lists.size(),
+                                              " neighbour lists for ", model_ids.size(),
+                                              " queries"));
+    }
+    ++answered;
+    for (std::size_t i = 0; i < lists.size(); ++i) {
+      merged[i].insert(merged[i].end(), lists[i].begin(), lists[i].end());
+    }
+  }
+  if (answered == 0) {
+    return absl::NotFoundError(
+        absl::StrCat("index has no models in collection '", part.collection, "'"));
+  }
+  if (answered > 1) {  // each shard's list is in order: merge them, the first shard's first on ties
+    for (std::vector<Scored>& list : merged) {
+      std::stable_sort(list.begin(), list.end(),
+                       [](const Scored& a, const Scored& b) { return a.distance < b.distance; });
+      if (list.size() > count) list.resize(count);
+    }
+  }
+  return merged;
+}
+
+absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> IndexShards::PairDistances(
+    const Part& part,
+    const std::vector<std::string>& model_ids,
+    const std::vector<std::vector<std::string>>& targets) {
+  if (model_ids.size() > kMaxGraphBatch || targets.size() != model_ids.size()) {
+    return absl::InternalError(absl::StrCat(model_ids.size(), " pair rows for ", targets.size(),
+                                            " target lists"));
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(std::vector<std::vector<v1::QueryModel>> queries,
+                            QueriesPerShard(part, model_ids));
+  std::vector<std::vector<Scored>> merged(model_ids.size());
+  for (std::size_t s = 0; s < shards_.size(); ++s) {
+    v1::PairDistancesRequest request;
+    request.set_collection(part.collection);
+    request.set_kl_epsilon(part.kl_epsilon);
+    for (std::size_t i = 0; i < model_ids.size(); ++i) {
+      v1::PairRow* row = request.add_rows();
+      *row->mutable_query() = std::move(queries[s][i]);
+      for (const std::string& id : targets[i]) {
+        if (shards_.size() == 1 || ShardOf(id) == s) row->add_model_ids(id);
+      }
+    }
+    v1::PairDistancesResponse response;
+    const absl::Status status =
+        rpc::CallWithRetry(shards_[s].get(), &v1::Index::Stub::PairDistances, request, &response,
+                           call_deadline_, retry_, stop_);
+    if (status.code() == absl::StatusCode::kNotFound && shards_.size() > 1) continue;
+    if (!status.ok()) {
+      return absl::Status(status.code(), absl::StrCat("index shard ", s, ": ", status.message()));
+    }
+    if (static_cast<std::size_t>(response.rows_size()) != model_ids.size()) {
+      return absl::InternalError(absl::StrCat("index shard ", s, " answered ", response.rows_size(),
+                                              " rows for ", model_ids.size()));
+    }
+    for (std::size_t i = 0; i < model_ids.size(); ++i) {
+      AppendScored(response.rows(static_cast<int>(i)), &merged[i]);
+    }
+  }
+  return merged;
 }
 
 }  // namespace meshseek

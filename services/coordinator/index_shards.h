@@ -84,8 +84,28 @@ class IndexShards {
     std::size_t size() const { return models.empty() ? 0 : models[0].size(); }
   };
   /// NOT_FOUND when no shard has a part's collection; FAILED_PRECONDITION
-  /// when the parts hold different models.
-  absl::StatusOr<PartModels> ExportParts(const std::vector<Part>& parts);
+  /// when the parts hold different models. Without `signatures`, the models'
+  /// ids, ordinals and labels only (what a large build holds in memory).
+  absl::StatusOr<PartModels> ExportParts(const std::vector<Part>& parts, bool signatures = true);
+
+  /// Rows of a neighbour graph in batches (docs/design.md "Approximate
+  /// neighbour graph"): for each of `model_ids` (models of the part), its
+  /// `count` nearest models of the part over every shard, nearest first,
+  /// exact distances on `candidates` proposals a shard (0: exact). A shard
+  /// answers the models it holds by id; with several shards, a model is sent
+  /// whole to the shards that do not hold it. At most kMaxGraphBatch ids.
+  absl::StatusOr<std::vector<std::vector<Scored>>> Neighbors(const Part& part,
+                                                             const std::vector<std::string>& model_ids,
+                                                             uint32_t count,
+                                                             uint32_t candidates);
+  /// For each of `model_ids` (models of the part), its exact distances to
+  /// those of `targets[i]` the part holds, in no particular order.
+  absl::StatusOr<std::vector<std::vector<Scored>>> PairDistances(
+      const Part& part,
+      const std::vector<std::string>& model_ids,
+      const std::vector<std::vector<std::string>>& targets);
+  /// Most queries of one Neighbors or PairDistances call.
+  static constexpr std::size_t kMaxGraphBatch = 4096;
 
   /// One row of the all-pairs matrices of the parts.
   struct Row {
@@ -105,9 +125,17 @@ class IndexShards {
                                   const std::vector<std::size_t>* only_rows = nullptr);
 
  private:
-  // Every model of `collection` on shard s (empty when it has none).
+  // The models `request` asks of shard s (empty when it has none).
   absl::StatusOr<std::vector<v1::IndexedModel>> Export(std::size_t s,
-                                                       const std::string& collection);
+                                                       const v1::ExportModelsRequest& request);
+  // The models of `model_ids` with their signatures, in that order, each
+  // from its shard; Aborted for one no longer there.
+  absl::StatusOr<std::vector<v1::IndexedModel>> Fetch(const Part& part,
+                                                      const std::vector<std::string>& model_ids);
+  // The queries of `model_ids` as shard s takes them: by id where it holds
+  // them, whole (from their shards) where it does not.
+  absl::StatusOr<std::vector<std::vector<v1::QueryModel>>> QueriesPerShard(
+      const Part& part, const std::vector<std::string>& model_ids);
   // Calls `method` on every shard at once; shard s's answer, or nullopt when
   // it does not hold the collection (NotFound). NotFound from every shard is
   // the result; any other error names its shard.

@@ -384,7 +384,8 @@ absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index,
   // Pass 2: the models, and the graph of the fused rows: from candidates
   // above the exact graph's size (fused_candidates.h).
   if (options.rerank.enabled() && n > graph_options.exact_graph_models) {
-    MESHSEEK_ASSIGN_OR_RETURN(const IndexShards::PartModels models, index->ExportParts(parts));
+    MESHSEEK_ASSIGN_OR_RETURN(const IndexShards::PartModels models,
+                              index->ExportParts(parts, /*signatures=*/false));
     if (models.size() != n) {
       return absl::AbortedError("the collection changed during its build; build again");
     }

@@ -9,6 +9,14 @@
 #include "common/rpc/convert.h"
 
 namespace meshseek {
+
+// A query as an engine takes it: a doc it holds (read from the engine, not
+// prepared again), or a signature given whole.
+struct EngineQuery {
+  std::optional<uint32_t> doc;
+  const ModelSignature* signature = nullptr;
+};
+
 namespace {
 
 absl::Span<const uint8_t> DescriptorBytes(const ModelSignature& signature) {
@@ -26,33 +34,46 @@ absl::Status Upsert(GlobalDescriptorIndex& engine, uint32_t doc, const ModelSign
 }
 
 absl::StatusOr<std::vector<KlNeighbor>> Search(const KlInvertedIndex& engine,
-                                               const ModelSignature& query,
+                                               const EngineQuery& query,
                                                std::size_t top_k,
                                                std::size_t candidates,
                                                int num_threads) {
-  return engine.Search(query.histogram, top_k, num_threads, candidates);
+  return query.doc.has_value()
+             ? engine.SearchStored(*query.doc, top_k, num_threads, candidates)
+             : engine.Search(query.signature->histogram, top_k, num_threads, candidates);
+}
+absl::StatusOr<absl::Span<const uint8_t>> QueryBytes(const GlobalDescriptorIndex& engine,
+                                                     const EngineQuery& query) {
+  if (query.doc.has_value()) return engine.Descriptor(*query.doc);
+  return DescriptorBytes(*query.signature);
 }
 absl::StatusOr<std::vector<KlNeighbor>> Search(const GlobalDescriptorIndex& engine,
-                                               const ModelSignature& query,
+                                               const EngineQuery& query,
                                                std::size_t top_k,
                                                std::size_t /*candidates: always exact*/,
                                                int num_threads) {
-  return engine.Search(DescriptorBytes(query), top_k, num_threads);
+  MESHSEEK_ASSIGN_OR_RETURN(const absl::Span<const uint8_t> bytes, QueryBytes(engine, query));
+  return engine.Search(bytes, top_k, num_threads);
 }
 
 // To every doc (`docs` nullptr) or to `docs`; single-threaded: the caller
 // runs queries in parallel.
 absl::StatusOr<std::vector<KlNeighbor>> Distances(const KlInvertedIndex& engine,
-                                                  const ModelSignature& query,
+                                                  const EngineQuery& query,
                                                   const std::vector<uint32_t>* docs) {
-  return docs != nullptr ? engine.DistancesTo(query.histogram, *docs, 1)
-                         : engine.Distances(query.histogram, 1);
+  if (docs == nullptr) {
+    if (!query.doc.has_value()) return engine.Distances(query.signature->histogram, 1);
+    MESHSEEK_ASSIGN_OR_RETURN(const SparseHistogram histogram, engine.Histogram(*query.doc));
+    return engine.Distances(histogram, 1);
+  }
+  return query.doc.has_value() ? engine.DistancesFromStored(*query.doc, *docs, 1)
+                               : engine.DistancesTo(query.signature->histogram, *docs, 1);
 }
 absl::StatusOr<std::vector<KlNeighbor>> Distances(const GlobalDescriptorIndex& engine,
-                                                  const ModelSignature& query,
+                                                  const EngineQuery& query,
                                                   const std::vector<uint32_t>* docs) {
-  return docs != nullptr ? engine.DistancesTo(DescriptorBytes(query), *docs)
-                         : engine.Distances(DescriptorBytes(query), 1);
+  MESHSEEK_ASSIGN_OR_RETURN(const absl::Span<const uint8_t> bytes, QueryBytes(engine, query));
+  return docs != nullptr ? engine.DistancesTo(bytes, *docs) : engine.Distances(bytes, 1);
 }
 
 template <typename Describe>
@@ -60,6 +81,15 @@ void Export(const KlInvertedIndex& engine, Describe&& describe) {
   engine.ForEach([&](uint32_t doc, const SparseHistogram& histogram) {
     rpc::SparseHistogramToProto(histogram, describe(doc).mutable_histogram());
   });
+}
+void ExportOne(const KlInvertedIndex& engine, uint32_t doc, v1::IndexedModel& out) {
+  rpc::SparseHistogramToProto(*engine.Histogram(doc), out.mutable_histogram());  // doc is held
+}
+void ExportOne(const GlobalDescriptorIndex& engine, uint32_t doc, v1::IndexedModel& out) {
+  const absl::Span<const uint8_t> bytes = *engine.Descriptor(doc);  // doc is held
+  v1::GlobalDescriptor* descriptor = out.mutable_global_descriptor();
+  descriptor->set_method(FeatureMethodName(engine.method()));
+  descriptor->set_data(bytes.data(), bytes.size());
 }
 template <typename Describe>
 void Export(const GlobalDescriptorIndex& engine, Describe&& describe) {
@@ -206,11 +236,17 @@ absl::StatusOr<std::vector<IndexCollection::Hit>> IndexCollection::Search(
     const ModelSignature& query, std::size_t top_k, std::size_t candidates, int num_threads) const {
   MESHSEEK_RETURN_IF_ERROR(CheckFits("", query));
   if (empty()) return std::vector<Hit>();
+  const EngineQuery q{std::nullopt, &query};
   MESHSEEK_ASSIGN_OR_RETURN(
       const std::vector<KlNeighbor> found,
       std::visit(
-          [&](const auto& engine) { return meshseek::Search(engine, query, top_k, candidates, num_threads); },
+          [&](const auto& engine) { return meshseek::Search(engine, q, top_k, candidates, num_threads); },
           *engine_));
+  return Ranked(found, top_k);
+}
+
+std::vector<IndexCollection::Hit> IndexCollection::Ranked(const std::vector<KlNeighbor>& found,
+                                                          std::size_t top_k) const {
   // The engine breaks ties by doc and returns every model tied with the k-th:
   // rank ties by ordinal (then id) as the whole collection would be.
   std::vector<Hit> hits;
@@ -222,6 +258,54 @@ absl::StatusOr<std::vector<IndexCollection::Hit>> IndexCollection::Search(
   });
   hits.resize(std::min(hits.size(), top_k));
   return hits;
+}
+
+absl::StatusOr<std::vector<IndexCollection::Hit>> IndexCollection::Neighbors(
+    const Query& query, std::size_t count, std::size_t candidates) const {
+  if (empty()) return std::vector<Hit>();
+  MESHSEEK_ASSIGN_OR_RETURN(const auto resolved, Resolve(query));
+  MESHSEEK_ASSIGN_OR_RETURN(
+      const std::vector<KlNeighbor> found,
+      std::visit(
+          [&](const auto& engine) { return meshseek::Search(engine, resolved, count, candidates, 1); },
+          *engine_));
+  return Ranked(found, count);
+}
+
+absl::StatusOr<std::vector<IndexCollection::Hit>> IndexCollection::PairDistances(
+    const Query& query, const google::protobuf::RepeatedPtrField<std::string>& model_ids) const {
+  if (empty()) return std::vector<Hit>();
+  MESHSEEK_ASSIGN_OR_RETURN(const auto resolved, Resolve(query));
+  const std::vector<uint32_t> docs = DocsInOrder(model_ids);
+  MESHSEEK_ASSIGN_OR_RETURN(
+      const std::vector<KlNeighbor> found,
+      std::visit([&](const auto& engine) { return meshseek::Distances(engine, resolved, &docs); },
+                 *engine_));
+  std::vector<Hit> hits;
+  hits.reserve(found.size());
+  for (const KlNeighbor& nb : found) hits.push_back({nb.distance, &models_.at(nb.doc)});
+  return hits;
+}
+
+absl::StatusOr<EngineQuery> IndexCollection::Resolve(const Query& query) const {
+  if (query.signature.has_value()) {
+    const bool stranger = !query.signature->descriptor.has_value() &&
+                          query.signature->histogram.words.empty() &&
+                          std::holds_alternative<KlInvertedIndex>(*engine_);
+    if (!stranger) {
+      if (absl::Status fits = CheckFits("", *query.signature); !fits.ok()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("query '", query.model_id, "': ", fits.message()));
+      }
+    }
+    return EngineQuery{std::nullopt, &*query.signature};
+  }
+  const auto it = docs_.find(query.model_id);
+  if (it == docs_.end()) {
+    return absl::NotFoundError(
+        absl::StrCat("query '", query.model_id, "' is not held by this index; send it whole"));
+  }
+  return EngineQuery{it->second, nullptr};
 }
 
 absl::Status IndexCollection::Distances(
@@ -255,8 +339,9 @@ absl::Status IndexCollection::Distances(
   float* out = response->mutable_distances()->mutable_data();
   std::vector<absl::Status> errors(queries.size());
   ParallelFor(queries.size(), num_threads, [&](std::size_t q) {
+    const EngineQuery query{std::nullopt, &queries[q]};
     absl::StatusOr<std::vector<KlNeighbor>> row = std::visit(
-        [&](const auto& engine) { return meshseek::Distances(engine, queries[q], subset ? &docs : nullptr); },
+        [&](const auto& engine) { return meshseek::Distances(engine, query, subset ? &docs : nullptr); },
         *engine_);
     if (!row.ok()) {
       errors[q] = row.status();
@@ -268,21 +353,31 @@ absl::Status IndexCollection::Distances(
   return absl::OkStatus();
 }
 
-std::vector<v1::IndexedModel> IndexCollection::Export() const {
+std::vector<v1::IndexedModel> IndexCollection::Export(
+    const google::protobuf::RepeatedPtrField<std::string>& model_ids, bool signatures) const {
   if (empty()) return {};
-  const std::vector<uint32_t> docs = DocsInOrder();
-  absl::flat_hash_map<uint32_t, std::size_t> position;
-  for (std::size_t i = 0; i < docs.size(); ++i) position[docs[i]] = i;
+  const std::vector<uint32_t> docs = model_ids.empty() ? DocsInOrder() : DocsInOrder(model_ids);
   std::vector<v1::IndexedModel> models(docs.size());
-  auto describe = [&](uint32_t doc) -> v1::IndexedModel& {
-    v1::IndexedModel& out = models[position.at(doc)];
-    const Model& model = models_.at(doc);
-    out.set_model_id(model.model_id);
-    out.set_ordinal(model.ordinal);
-    out.set_label(model.label);
-    return out;
-  };
-  std::visit([&](const auto& engine) { meshseek::Export(engine, describe); }, *engine_);
+  absl::flat_hash_map<uint32_t, std::size_t> position;
+  for (std::size_t i = 0; i < docs.size(); ++i) {
+    position[docs[i]] = i;
+    const Model& model = models_.at(docs[i]);
+    models[i].set_model_id(model.model_id);
+    models[i].set_ordinal(model.ordinal);
+    models[i].set_label(model.label);
+  }
+  if (!signatures) return models;
+  auto describe = [&](uint32_t doc) -> v1::IndexedModel& { return models[position.at(doc)]; };
+  // Every model: one pass over the engine; a few: each read on its own.
+  std::visit(
+      [&](const auto& engine) {
+        if (model_ids.empty()) {
+          meshseek::Export(engine, describe);
+        } else {
+          for (uint32_t doc : docs) ExportOne(engine, doc, describe(doc));
+        }
+      },
+      *engine_);
   return models;
 }
 

@@ -45,6 +45,8 @@ struct ModelSignature {
                                               const std::string& what);
 };
 
+struct EngineQuery;  // index_collection.cc
+
 class IndexCollection {
  public:
   struct Model {
@@ -95,8 +97,29 @@ class IndexCollection {
                          const google::protobuf::RepeatedPtrField<std::string>& model_ids,
                          int num_threads,
                          v1::DistancesResponse* response) const;
-  /// Every model as added, in order.
-  std::vector<v1::IndexedModel> Export() const;
+  /// A query of Neighbors or PairDistances: a model held here, by id
+  /// (`signature` empty), or one given whole.
+  struct Query {
+    std::string model_id;
+    std::optional<ModelSignature> signature;
+  };
+  /// The query's `count` nearest models in (distance, ordinal, model id)
+  /// order, exact on `candidates` proposals when > 0 (as Search); one
+  /// thread, so a caller runs many queries in parallel. NotFound for a query
+  /// by id not held here; InvalidArgument for one given whole that does not
+  /// fit (an empty histogram fits: every model's stranger).
+  absl::StatusOr<std::vector<Hit>> Neighbors(const Query& query,
+                                             std::size_t count,
+                                             std::size_t candidates) const;
+  /// The query's exact distances to those of `model_ids` held here, in
+  /// (ordinal, model id) order; one thread. Errors as Neighbors.
+  absl::StatusOr<std::vector<Hit>> PairDistances(
+      const Query& query, const google::protobuf::RepeatedPtrField<std::string>& model_ids) const;
+  /// Every model as added, in order, or those of `model_ids` held (each
+  /// once); without their histograms or descriptors unless `signatures`.
+  std::vector<v1::IndexedModel> Export(
+      const google::protobuf::RepeatedPtrField<std::string>& model_ids = {},
+      bool signatures = true) const;
   /// Every model id, in order.
   std::vector<std::string> ModelIds() const;
   /// Bytes held by the engine.
@@ -104,6 +127,11 @@ class IndexCollection {
 
  private:
   using Engine = std::variant<KlInvertedIndex, GlobalDescriptorIndex>;
+
+  // The query as the engine takes it (index_collection.cc).
+  absl::StatusOr<EngineQuery> Resolve(const Query& query) const;
+  // Engine answers as hits, by (distance, ordinal, model id), the first top_k.
+  std::vector<Hit> Ranked(const std::vector<KlNeighbor>& found, std::size_t top_k) const;
 
   // Docs in (ordinal, model id) order: all, or those of `model_ids` held.
   std::vector<uint32_t> DocsInOrder() const;

@@ -111,5 +111,86 @@ TEST(IndexCollectionTest, DescriptorsExportedAndRefusedAsHistograms) {
   EXPECT_THAT(refused.message(), HasSubstr("query 0"));
 }
 
+// Neighbors and PairDistances: a query held here (by id) answers as the same
+// model given whole; over either engine.
+void ExpectNeighborsOfHeldAndWholeAgree(IndexCollection& collection,
+                                        const std::vector<ModelSignature>& signatures) {
+  for (std::size_t i = 0; i < signatures.size(); ++i) {
+    const std::string id(1, static_cast<char>('a' + i));
+    const IndexCollection::Query held{id, std::nullopt};
+    const IndexCollection::Query whole{id, signatures[i]};
+    const auto by_id = collection.Neighbors(held, 2, 0);
+    const auto given = collection.Neighbors(whole, 2, 0);
+    ASSERT_TRUE(by_id.ok() && given.ok()) << by_id.status() << given.status();
+    ASSERT_EQ(by_id->size(), 2u);
+    ASSERT_EQ(given->size(), 2u);
+    EXPECT_EQ((*by_id)[0].model->model_id, id);  // itself first, at 0
+    EXPECT_EQ((*by_id)[0].distance, 0.0f);
+    for (std::size_t j = 0; j < 2; ++j) {
+      EXPECT_EQ((*by_id)[j].model, (*given)[j].model);
+      EXPECT_EQ((*by_id)[j].distance, (*given)[j].distance);
+    }
+    google::protobuf::RepeatedPtrField<std::string> targets;
+    targets.Add("c");
+    targets.Add("unknown");
+    targets.Add("a");
+    const auto pairs = collection.PairDistances(held, targets);
+    ASSERT_TRUE(pairs.ok()) << pairs.status();
+    ASSERT_EQ(pairs->size(), 2u);  // the unknown id left out, in (ordinal, id) order
+    EXPECT_EQ((*pairs)[0].model->model_id, "a");
+    EXPECT_EQ((*pairs)[1].model->model_id, "c");
+    const auto search = collection.Search(signatures[i], 3, 0, 1);
+    for (const IndexCollection::Hit& hit : *search) {
+      for (const IndexCollection::Hit& pair : *pairs) {
+        if (pair.model == hit.model) EXPECT_EQ(pair.distance, hit.distance);
+      }
+    }
+  }
+  const auto stranger = collection.Neighbors({"zz", std::nullopt}, 1, 0);
+  EXPECT_EQ(stranger.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(stranger.status().message(), HasSubstr("'zz'"));
+}
+
+TEST(IndexCollectionTest, NeighborsAndPairDistancesOfHistograms) {
+  IndexCollection collection;
+  const std::vector<ModelSignature> signatures = {Histogram(8, {1, 2}), Histogram(8, {1, 3}),
+                                                  Histogram(8, {5, 6})};
+  for (std::size_t i = 0; i < signatures.size(); ++i) {
+    ASSERT_TRUE(collection.Place(std::string(1, 'a' + i), i, "", signatures[i]).ok());
+  }
+  ExpectNeighborsOfHeldAndWholeAgree(collection, signatures);
+  const auto misfit = collection.Neighbors({"q", Histogram(16, {1})}, 1, 0);
+  EXPECT_EQ(misfit.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(misfit.status().message(), HasSubstr("query 'q'"));
+}
+
+TEST(IndexCollectionTest, NeighborsAndPairDistancesOfDescriptors) {
+  IndexCollection collection;
+  const std::vector<ModelSignature> signatures = {Descriptor(1), Descriptor(2), Descriptor(9)};
+  for (std::size_t i = 0; i < signatures.size(); ++i) {
+    ASSERT_TRUE(collection.Place(std::string(1, 'a' + i), i, "", signatures[i]).ok());
+  }
+  ExpectNeighborsOfHeldAndWholeAgree(collection, signatures);
+}
+
+TEST(IndexCollectionTest, ExportsASubsetWithOrWithoutSignatures) {
+  IndexCollection collection;
+  ASSERT_TRUE(collection.Place("b", 1, "y", Histogram(8, {1, 3})).ok());
+  ASSERT_TRUE(collection.Place("a", 0, "x", Histogram(8, {1, 2})).ok());
+  google::protobuf::RepeatedPtrField<std::string> ids;
+  ids.Add("b");
+  ids.Add("gone");
+  ids.Add("a");
+  const std::vector<v1::IndexedModel> bare = collection.Export(ids, /*signatures=*/false);
+  ASSERT_EQ(bare.size(), 2u);
+  EXPECT_EQ(bare[0].model_id(), "a");
+  EXPECT_EQ(bare[0].label(), "x");
+  EXPECT_FALSE(bare[0].has_histogram());
+  const std::vector<v1::IndexedModel> full = collection.Export(ids);
+  ASSERT_EQ(full.size(), 2u);
+  EXPECT_EQ(full[1].model_id(), "b");
+  EXPECT_THAT(full[1].histogram().bins(), ElementsAre(1, 3));
+}
+
 }  // namespace
 }  // namespace meshseek

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "absl/strings/str_cat.h"
+#include "common/base/parallel.h"
 #include "common/base/status_macros.h"
 
 namespace meshseek {
@@ -186,7 +187,11 @@ absl::Status IndexService::ExportModels(const v1::ExportModelsRequest& request,
       return absl::NotFoundError(
           absl::StrCat("index has no models in collection '", request.collection(), "'"));
     }
-    models = it->second.Export();
+    if (request.model_ids_size() > kMaxDistanceModels) {
+      return absl::InvalidArgumentError(absl::StrCat("export: ", request.model_ids_size(),
+                                                     " model ids, at most ", kMaxDistanceModels));
+    }
+    models = it->second.Export(request.model_ids(), !request.without_signatures());
   }
   for (const v1::IndexedModel& model : models) {
     if (call.cancelled() || !write(model)) return absl::CancelledError("");
@@ -230,6 +235,130 @@ absl::StatusOr<v1::DistancesResponse> IndexService::Distances(const v1::Distance
   const absl::Status status =
       collection->Distances(queries, request.model_ids(), options_.num_threads, &response);
   if (!status.ok()) return Prefixed(status, "distances: ");
+  return response;
+}
+
+namespace {
+
+// The queries of a Neighbors or PairDistances request, checked.
+absl::StatusOr<std::vector<IndexCollection::Query>> QueriesOf(
+    const std::vector<const v1::QueryModel*>& asked, const std::string& what) {
+  std::vector<IndexCollection::Query> queries(asked.size());
+  for (std::size_t q = 0; q < asked.size(); ++q) {
+    const v1::QueryModel& m = *asked[q];
+    queries[q].model_id = m.model_id();
+    if (!m.has_model()) continue;
+    MESHSEEK_ASSIGN_OR_RETURN(
+        queries[q].signature,
+        SignatureOf(m.model().histogram(), m.model().has_global_descriptor(),
+                    m.model().global_descriptor(), absl::StrCat(what, " query ", q)));
+  }
+  return queries;
+}
+
+void AppendHits(const std::vector<IndexCollection::Hit>& hits, v1::NeighborList* list) {
+  for (const IndexCollection::Hit& hit : hits) {
+    list->add_neighbor_ids(hit.model->model_id);
+    list->add_ordinals(hit.model->ordinal);
+    list->add_distances(hit.distance);
+  }
+}
+
+}  // namespace
+
+absl::Status IndexService::Neighbors(const v1::NeighborsRequest& request,
+                                     rpc::Writer<v1::NeighborLists> write,
+                                     const rpc::CallContext& call) {
+  if (request.count() < 1 || request.count() > kMaxNeighbors) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("neighbors: count ", request.count(), " is not in [1, ", kMaxNeighbors, "]"));
+  }
+  if (request.candidates() != 0 &&
+      (request.candidates() < request.count() || request.candidates() > kMaxDistanceModels)) {
+    return absl::InvalidArgumentError(absl::StrCat("neighbors: candidates ", request.candidates(),
+                                                   " is not 0 or in [count, ",
+                                                   kMaxDistanceModels, "]"));
+  }
+  if (request.queries_size() > kMaxDistanceQueries) {
+    return absl::InvalidArgumentError(absl::StrCat("neighbors: ", request.queries_size(),
+                                                   " queries, at most ", kMaxDistanceQueries));
+  }
+  // The queries: those asked, or every model held (by id, in order).
+  std::vector<v1::QueryModel> every;
+  std::vector<const v1::QueryModel*> asked;
+  for (const v1::QueryModel& q : request.queries()) asked.push_back(&q);
+  MESHSEEK_RETURN_IF_ERROR(UseEpsilon(request.collection(), request.kl_epsilon()));
+  if (asked.empty()) {
+    absl::ReaderMutexLock lock(&mutex_);
+    MESHSEEK_ASSIGN_OR_RETURN(const IndexCollection* collection,
+                              FindCollection(request.collection(), request.kl_epsilon()));
+    for (std::string& id : collection->ModelIds()) every.emplace_back().set_model_id(std::move(id));
+    for (const v1::QueryModel& q : every) asked.push_back(&q);
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<IndexCollection::Query> queries,
+                            QueriesOf(asked, "neighbors:"));
+  // A batch at a time under the reader lock, written after it: writers wait
+  // for one batch at most, and a slow reader holds up nobody.
+  for (std::size_t begin = 0; begin < queries.size(); begin += kNeighborBatch) {
+    const std::size_t end = std::min(queries.size(), begin + kNeighborBatch);
+    v1::NeighborLists lists;
+    std::vector<absl::Status> errors(end - begin);
+    {
+      absl::ReaderMutexLock lock(&mutex_);
+      MESHSEEK_ASSIGN_OR_RETURN(const IndexCollection* collection,
+                                FindCollection(request.collection(), request.kl_epsilon()));
+      for (std::size_t q = begin; q < end; ++q) lists.add_lists()->set_model_id(queries[q].model_id);
+      ParallelFor(end - begin, options_.num_threads, [&](std::size_t i) {
+        absl::StatusOr<std::vector<IndexCollection::Hit>> hits =
+            collection->Neighbors(queries[begin + i], request.count(), request.candidates());
+        if (hits.ok()) {
+          AppendHits(*hits, lists.mutable_lists(static_cast<int>(i)));
+        } else {
+          errors[i] = hits.status();
+        }
+      });
+    }
+    for (const absl::Status& e : errors) MESHSEEK_RETURN_IF_ERROR(Prefixed(e, "neighbors: "));
+    if (call.cancelled() || !write(lists)) return absl::CancelledError("");
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<v1::PairDistancesResponse> IndexService::PairDistances(
+    const v1::PairDistancesRequest& request, const rpc::CallContext&) {
+  if (request.rows_size() > kMaxDistanceQueries) {
+    return absl::InvalidArgumentError(absl::StrCat("pair distances: ", request.rows_size(),
+                                                   " rows, at most ", kMaxDistanceQueries));
+  }
+  std::size_t ids = 0;
+  std::vector<const v1::QueryModel*> asked;
+  for (const v1::PairRow& row : request.rows()) {
+    ids += row.model_ids_size();
+    asked.push_back(&row.query());
+  }
+  if (ids > kMaxPairIds) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("pair distances: ", ids, " model ids, at most ", kMaxPairIds));
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<IndexCollection::Query> queries,
+                            QueriesOf(asked, "pair distances:"));
+  MESHSEEK_RETURN_IF_ERROR(UseEpsilon(request.collection(), request.kl_epsilon()));
+  absl::ReaderMutexLock lock(&mutex_);
+  MESHSEEK_ASSIGN_OR_RETURN(const IndexCollection* collection,
+                            FindCollection(request.collection(), request.kl_epsilon()));
+  v1::PairDistancesResponse response;
+  std::vector<absl::Status> errors(queries.size());
+  for (const IndexCollection::Query& q : queries) response.add_rows()->set_model_id(q.model_id);
+  ParallelFor(queries.size(), options_.num_threads, [&](std::size_t q) {
+    absl::StatusOr<std::vector<IndexCollection::Hit>> hits =
+        collection->PairDistances(queries[q], request.rows(static_cast<int>(q)).model_ids());
+    if (hits.ok()) {
+      AppendHits(*hits, response.mutable_rows(static_cast<int>(q)));
+    } else {
+      errors[q] = hits.status();
+    }
+  });
+  for (const absl::Status& e : errors) MESHSEEK_RETURN_IF_ERROR(Prefixed(e, "pair distances: "));
   return response;
 }
 

@@ -47,8 +47,16 @@ class IndexService final : public v1::Index::Service {
  public:
   /// Most query histograms in one Distances request.
   static constexpr int kMaxDistanceQueries = 4096;
-  /// Most model ids one Distances request may restrict itself to.
+  /// Most model ids one Distances request may restrict itself to (also the
+  /// most candidates of a Neighbors request).
   static constexpr int kMaxDistanceModels = 65536;
+  /// Most neighbours a Neighbors query may ask for.
+  static constexpr uint32_t kMaxNeighbors = 1024;
+  /// Most model ids in all the rows of one PairDistances request.
+  static constexpr std::size_t kMaxPairIds = 1 << 20;
+  /// Lists a Neighbors stream computes under one lock and sends in one
+  /// message: about 4 MB of message at 50 neighbours.
+  static constexpr std::size_t kNeighborBatch = 256;
 
   static absl::StatusOr<std::unique_ptr<IndexService>> Create(const IndexServiceOptions& options);
 
@@ -65,6 +73,11 @@ class IndexService final : public v1::Index::Service {
                                                   const rpc::CallContext& call);
   absl::StatusOr<v1::ListModelsResponse> ListModels(const v1::ListModelsRequest& request,
                                                     const rpc::CallContext& call);
+  absl::Status Neighbors(const v1::NeighborsRequest& request,
+                         rpc::Writer<v1::NeighborLists> write,
+                         const rpc::CallContext& call);
+  absl::StatusOr<v1::PairDistancesResponse> PairDistances(const v1::PairDistancesRequest& request,
+                                                          const rpc::CallContext& call);
 
   // gRPC entry points (common/rpc/handler.h).
   grpc::Status AddModel(grpc::ServerContext* context,
@@ -96,6 +109,16 @@ class IndexService final : public v1::Index::Service {
                           const v1::ListModelsRequest* request,
                           v1::ListModelsResponse* response) override {
     return rpc::Serve(context, request, response, this, &IndexService::ListModels);
+  }
+  grpc::Status Neighbors(grpc::ServerContext* context,
+                         const v1::NeighborsRequest* request,
+                         grpc::ServerWriter<v1::NeighborLists>* writer) override {
+    return rpc::Serve(context, request, writer, this, &IndexService::Neighbors);
+  }
+  grpc::Status PairDistances(grpc::ServerContext* context,
+                             const v1::PairDistancesRequest* request,
+                             v1::PairDistancesResponse* response) override {
+    return rpc::Serve(context, request, response, this, &IndexService::PairDistances);
   }
 
   /// Bytes held by the in-memory index of every collection (for benchmarks).
