@@ -8,13 +8,15 @@
 //
 //   fused_scale_benchmark --models 10000 [--shards 1] [--candidates 50]
 //     [--graph_candidates 50] [--exact_graph_models 0] [--queries 100]
-//     [--method bfdsift+rld+lsf+lfd]
+//     [--postings_max_models 20000] [--live_models 5] [--method bfdsift+rld+lsf+lfd]
 //
 // Prints the add time, the ranking-state build time (approximate graph above
 // --exact_graph_models), the search part of fused queries (after
 // extraction: new synthetic signatures) with and without candidates, p50 and
-// p95, and the peak resident memory of each index server and of this process
-// (the coordinator's share: it holds every signature while it builds).
+// p95, the time from a new model's add to a query that returns it (live
+// ingest, joined from candidates), and the peak resident memory and bytes on
+// disk a model of each index server, and this process's peak (the
+// coordinator's share: ids, the state, a batch of lists).
 // What it leaves out of the services: the coordinator's SQLite store and
 // extraction (the extraction of a query is bench/extract_benchmark's).
 #include <signal.h>
@@ -37,6 +39,7 @@
 #include "bench/synthetic_histograms.h"
 #include "cli/pipeline_flags.h"
 #include "common/base/parallel.h"
+#include "common/base/status_macros.h"
 #include "common/global/lfd.h"
 #include "common/rpc/convert.h"
 #include "common/rpc/free_port.h"
@@ -50,6 +53,9 @@ ABSL_FLAG(uint32_t, graph_candidates, 50, "candidates per method of the approxim
 ABSL_FLAG(int64_t, exact_graph_models, 0, "all pairs up to this many models");
 ABSL_FLAG(int, queries, 100, "fused queries timed, each way");
 ABSL_FLAG(std::string, work_dir, "", "the index servers' data (default: a temporary folder)");
+ABSL_FLAG(std::size_t, postings_max_models, 20000,
+          "the index servers' --postings_max_models (postings freed past it)");
+ABSL_FLAG(int, live_models, 5, "models ingested after the build, timed to searchable");
 
 namespace meshseek {
 namespace {
@@ -127,7 +133,9 @@ int Run() {
       const std::string log = dir + "/log";
       freopen(log.c_str(), "w", stderr);
       execl(MESHSEEK_INDEX_PATH, MESHSEEK_INDEX_PATH, absl::StrCat("--port=", port).c_str(),
-            absl::StrCat("--data_dir=", dir).c_str(), static_cast<char*>(nullptr));
+            absl::StrCat("--data_dir=", dir).c_str(),
+            absl::StrCat("--postings_max_models=", absl::GetFlag(FLAGS_postings_max_models)).c_str(),
+            static_cast<char*>(nullptr));
       _exit(127);
     }
     servers.push_back(pid);
@@ -144,13 +152,11 @@ int Run() {
     part.options = method;
     plan.parts.push_back(part);
   }
-  // 1. Adds, several in flight (the first waits for the servers to start).
-  auto start = std::chrono::steady_clock::now();
-  std::vector<absl::Status> errors(n);
-  ParallelFor(static_cast<std::size_t>(n), 8, [&](std::size_t i) {
+  // Model i's signatures (seeded by i), added to every part.
+  const auto add_model = [&](std::size_t i, std::vector<IndexSignature>* kept) -> absl::Status {
     std::mt19937_64 rng(i + 1);
     for (const CollectionInfo& part : plan.parts) {
-      const IndexSignature s = Signature(rng, part.options);
+      IndexSignature s = Signature(rng, part.options);
       v1::AddModelRequest add;
       add.set_collection(part.name);
       add.set_model_id(absl::StrCat("m", i));
@@ -161,10 +167,16 @@ int Run() {
       } else {
         *add.mutable_histogram() = s.histogram;
       }
-      errors[i] = index.Add(add);
-      if (!errors[i].ok()) return;
+      MESHSEEK_RETURN_IF_ERROR(index.Add(add));
+      if (kept != nullptr) kept->push_back(std::move(s));
     }
-  });
+    return absl::OkStatus();
+  };
+  // 1. Adds, several in flight (the first waits for the servers to start).
+  auto start = std::chrono::steady_clock::now();
+  std::vector<absl::Status> errors(n);
+  ParallelFor(static_cast<std::size_t>(n), 8,
+              [&](std::size_t i) { errors[i] = add_model(i, nullptr); });
   for (const absl::Status& e : errors) {
     if (!e.ok()) {
       std::fprintf(stderr, "add: %s\n", e.ToString().c_str());
@@ -211,8 +223,43 @@ int Run() {
                 candidates == 0 ? "exact" : absl::StrCat(candidates, " candidates").c_str(),
                 Percentiles(ms).c_str());
   }
+  // 4. Live ingest: a model added after the build (its extraction done),
+  //    joined from candidates as the coordinator's live index does, until a
+  //    query with its signatures returns it first.
+  std::vector<double> live_ms;
+  for (int l = 0; l < absl::GetFlag(FLAGS_live_models); ++l) {
+    const std::size_t i = static_cast<std::size_t>(n) + l;
+    const auto t = std::chrono::steady_clock::now();
+    std::vector<IndexSignature> own;
+    if (!add_model(i, &own).ok()) return 1;
+    std::vector<const IndexSignature*> signatures;
+    for (const IndexSignature& s : own) signatures.push_back(&s);
+    auto distances = CandidatePartDistances(&index, plan, signatures, graph.graph_candidates);
+    if (!distances.ok()) return 1;
+    auto join = ranking->PlanJoin(absl::StrCat("m", i), i, "", *distances);
+    if (!join.ok() || !ranking->Apply(*join).ok()) return 1;
+    auto asked = CandidatePartDistances(&index, plan, signatures, absl::GetFlag(FLAGS_candidates));
+    if (!asked.ok()) return 1;
+    auto found = ranking->Query(*asked, plan.options, 10);
+    if (!found.ok() || found->empty() || (*found)[0].model_id() != absl::StrCat("m", i)) {
+      std::fprintf(stderr, "live model m%zu not returned first\n", i);
+      return 1;
+    }
+    live_ms.push_back(Seconds(t) * 1e3);
+  }
+  if (!live_ms.empty()) {
+    std::printf("live ingest, added to every part until a query returns it: %s\n",
+                Percentiles(live_ms).c_str());
+  }
   for (std::size_t s = 0; s < servers.size(); ++s) {
-    std::printf("index shard %zu: peak RSS %.0f MB\n", s, PeakMb(servers[s]));
+    uint64_t disk = 0;
+    std::error_code ec;
+    for (const auto& f : std::filesystem::recursive_directory_iterator(
+             absl::StrCat(work, "/index-", s), ec)) {
+      if (f.is_regular_file()) disk += f.file_size();
+    }
+    std::printf("index shard %zu: peak RSS %.0f MB, %.1f KB a model on disk\n", s,
+                PeakMb(servers[s]), disk / 1024.0 / n);
     kill(servers[s], SIGTERM);
     waitpid(servers[s], nullptr, 0);
   }

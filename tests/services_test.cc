@@ -708,6 +708,12 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
   ASSERT_TRUE(reference.ok()) << reference.status();
 
   Stack stack(*dir_ + "/fused", 1, 512, /*index_shards=*/2);
+  // One shard frees its postings past 4 models: its full rows then come
+  // from the forward file (kl_inverted_index.h, "Storage"), and every matrix
+  // below must still be the in-process one bit for bit.
+  stack.index(0).Kill(SIGKILL);
+  stack.index(0).AddArgs({"--postings_max_models=4"});
+  stack.index(0).Start();
   ASSERT_TRUE(stack.WaitServing());
   auto stub = stack.Coordinator();
   ASSERT_TRUE(CreateCollection(stub.get(), "fused", params).ok());

@@ -1,17 +1,26 @@
 #include "common/search/fusion.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
 
 namespace meshseek {
 
-std::vector<std::size_t> ScaleSampleRows(std::size_t n) {
-  const std::size_t count = std::min(n, kScaleRows);
-  std::vector<std::size_t> rows(count);
-  for (std::size_t i = 0; i < count; ++i) rows[i] = i * n / count;
-  return rows;
+namespace {
+
+// i * n / count for i < min(n, count): evenly spread, increasing.
+std::vector<std::size_t> EvenSample(std::size_t n, std::size_t most) {
+  const std::size_t count = std::min(n, most);
+  std::vector<std::size_t> at(count);
+  for (std::size_t i = 0; i < count; ++i) at[i] = i * n / count;
+  return at;
 }
+
+}  // namespace
+
+std::vector<std::size_t> ScaleSampleRows(std::size_t n) { return EvenSample(n, kScaleRows); }
+std::vector<std::size_t> ScaleSampleColumns(std::size_t n) { return EvenSample(n, kScaleColumns); }
 
 void DistanceScale::AddRow(std::size_t self, absl::Span<const float> row) {
   for (std::size_t j = 0; j < row.size(); ++j) {

@@ -32,13 +32,23 @@ namespace meshseek {
 /// i < min(n, kScaleRows), increasing.
 inline constexpr std::size_t kScaleRows = 256;
 std::vector<std::size_t> ScaleSampleRows(std::size_t n);
+/// Columns of those rows sampled in a collection of more than
+/// kScaleColumns models (the services' builds: each sampled distance is an
+/// exact one from the forward index, and a whole row of a 100,000-model
+/// BF-DSIFT collection without postings reads 4 GB): i * n / kScaleColumns
+/// for i < kScaleColumns; every column up to kScaleColumns models, so every
+/// development set's scales, and with them its matrices, are those of whole
+/// rows.
+inline constexpr std::size_t kScaleColumns = 8192;
+std::vector<std::size_t> ScaleSampleColumns(std::size_t n);
 
 /// Accumulates the mean of a method's finite off-diagonal distances over
 /// the sampled rows, in the order rows are added (the order of
 /// ScaleSampleRows).
 class DistanceScale {
  public:
-  /// `row`: model `self`'s distances to every model.
+  /// `row`: model `self`'s distances to every model (or to the sampled
+  /// columns, `self` its position among them or any larger value).
   void AddRow(std::size_t self, absl::Span<const float> row);
   /// The mean; 1 when no finite off-diagonal distance was seen or it is 0
   /// (every model alike: nothing to normalise).

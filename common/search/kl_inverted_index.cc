@@ -1,5 +1,7 @@
 #include "common/search/kl_inverted_index.h"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
+#include "common/search/forward_store.h"
 
 namespace meshseek {
 namespace {
@@ -38,6 +41,15 @@ std::vector<CommonSums>& Scratch() {
 // The embedding's fixed seed: its axes are a function of the sample alone.
 constexpr uint64_t kEmbeddingSeed = 0x6d657368u;  // "mesh"
 
+// Hands the heap's free pages back to the system after a large transient
+// allocation (the embedding's fit, freed postings): glibc keeps them in its
+// arenas otherwise, and a service's resident memory would stay at its peak.
+void ReturnFreedMemory() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
+}
+
 bool Closer(const KlNeighbor& a, const KlNeighbor& b) {
   return a.distance < b.distance || (a.distance == b.distance && a.doc < b.doc);
 }
@@ -54,13 +66,36 @@ struct KlInvertedIndex::PreparedQuery {
   bool empty() const { return words.empty(); }
 };
 
+// A forward entry: word in the high 16 bits, value id in the low.
+uint32_t Entry(uint32_t word, uint16_t value) { return word << 16 | value; }
+uint32_t WordOf(uint32_t entry) { return entry >> 16; }
+uint16_t ValueIdOf(uint32_t entry) { return static_cast<uint16_t>(entry & 0xffff); }
+
+// A query as dense arrays, zero off its words, so that a model's forward
+// entries are summed in word order with zero terms elsewhere: the same
+// doubles as the postings' scan.
+struct KlInvertedIndex::DenseQuery {
+  explicit DenseQuery(const PreparedQuery& q, uint32_t vocabulary)
+      : x(vocabulary, 0.0), g(vocabulary, 0.0) {
+    for (std::size_t i = 0; i < q.words.size(); ++i) {
+      x[q.words[i]] = q.weights[i];
+      g[q.words[i]] = q.g[i];
+    }
+  }
+  std::vector<double> x, g;
+};
+
 struct KlInvertedIndex::Segment {
   // Per word, the postings of the segment's models: slot and value id.
   struct Postings {
     std::vector<uint16_t> slots;
     std::vector<uint16_t> values;
   };
-  explicit Segment(uint32_t vocabulary) : postings(vocabulary) {}
+  Segment(uint32_t vocabulary, bool with_postings) : postings(with_postings ? vocabulary : 0) {}
+
+  bool has_postings() const { return !postings.empty(); }
+  // Frees the postings: scans read the forward entries from here on.
+  void DropPostings() { std::vector<Postings>().swap(postings); }
 
   // Value id of `weight` (with its g), added to the dictionary if new.
   uint16_t ValueOf(float weight, float g) {
@@ -76,33 +111,52 @@ struct KlInvertedIndex::Segment {
     return values.size() + fresh <= kMaxValues;
   }
 
-  // Adds a model at the next slot: postings, forward entries, constants.
-  void Add(uint32_t doc, const PreparedQuery& q) {
-    const auto slot = static_cast<uint16_t>(docs.size());
+  // Adds a model at the next slot: its forward entries (appended to
+  // `forward`), postings where kept, constants. Unchanged but for new
+  // dictionary values when the append fails.
+  absl::Status Add(uint32_t doc, const PreparedQuery& q, ForwardStore* forward) {
+    std::vector<uint32_t> entries(q.words.size());
     for (std::size_t i = 0; i < q.words.size(); ++i) {
-      const uint16_t value = ValueOf(q.weights[i], q.g[i]);
-      Postings& p = postings[q.words[i]];
-      p.slots.push_back(slot);
-      p.values.push_back(value);
-      forward_words.push_back(static_cast<uint16_t>(q.words[i]));
-      forward_values.push_back(value);
+      entries[i] = Entry(q.words[i], ValueOf(q.weights[i], q.g[i]));
     }
-    forward_end.push_back(forward_words.size());
+    MESHSEEK_ASSIGN_OR_RETURN(const uint64_t offset, forward->Append(entries));
+    AddSlot(doc, offset, entries, q.empty(), q.c, q.e, q.a, q.big_g);
+    return absl::OkStatus();
+  }
+  // The slot bookkeeping of Add, for entries already in the store (also
+  // what compaction copies).
+  void AddSlot(uint32_t doc, uint64_t offset, absl::Span<const uint32_t> entries, bool no_words,
+               double c_, double e_, double a_, double big_g_) {
+    const auto slot = static_cast<uint16_t>(docs.size());
+    if (has_postings()) {
+      for (uint32_t entry : entries) {
+        Postings& p = postings[WordOf(entry)];
+        p.slots.push_back(slot);
+        p.values.push_back(ValueIdOf(entry));
+      }
+    }
+    forward_offset.push_back(offset);
+    forward_count.push_back(static_cast<uint32_t>(entries.size()));
     docs.push_back(doc);
     live.push_back(1);
-    empty.push_back(q.empty() ? 1 : 0);
-    c.push_back(q.c);
-    e.push_back(q.e);
-    a.push_back(q.a);
-    big_g.push_back(q.big_g);
+    empty.push_back(no_words ? 1 : 0);
+    c.push_back(c_);
+    e.push_back(e_);
+    a.push_back(a_);
+    big_g.push_back(big_g_);
+  }
+  absl::Span<const uint32_t> Entries(std::size_t slot, const ForwardStore& forward,
+                                     std::vector<uint32_t>* buffer) const {
+    return forward.Read(forward_offset[slot], forward_count[slot], buffer);
   }
   // The histogram at `slot` (as given) with its prepared constants.
-  PreparedQuery Stored(std::size_t slot) const {
+  PreparedQuery Stored(std::size_t slot, const ForwardStore& forward) const {
     PreparedQuery q;
-    for (std::size_t i = slot == 0 ? 0 : forward_end[slot - 1]; i < forward_end[slot]; ++i) {
-      q.words.push_back(forward_words[i]);
-      q.weights.push_back(values[forward_values[i]][1]);
-      q.g.push_back(values[forward_values[i]][0]);
+    std::vector<uint32_t> buffer;
+    for (uint32_t entry : Entries(slot, forward, &buffer)) {
+      q.words.push_back(WordOf(entry));
+      q.weights.push_back(values[ValueIdOf(entry)][1]);
+      q.g.push_back(values[ValueIdOf(entry)][0]);
     }
     q.c = c[slot];
     q.e = e[slot];
@@ -110,14 +164,49 @@ struct KlInvertedIndex::Segment {
     q.big_g = big_g[slot];
     return q;
   }
+  // The two common sums of the model at `slot` against a dense query.
+  CommonSums ForwardSums(absl::Span<const uint32_t> entries, const DenseQuery& q) const {
+    double query_side = 0.0, model_side = 0.0;
+    for (uint32_t entry : entries) {
+      const uint32_t word = WordOf(entry);
+      const Float2 value = values[ValueIdOf(entry)];
+      query_side += q.x[word] * static_cast<double>(value[0]);
+      model_side += static_cast<double>(value[1]) * q.g[word];
+    }
+    return CommonSums{query_side, model_side};
+  }
 
-  std::vector<Postings> postings;  // per word
-  // Per slot, its words and value ids in word order (the forward index, for
-  // exact distances to a few candidates): entries [forward_end[slot - 1],
-  // forward_end[slot]).
-  std::vector<uint16_t> forward_words;
-  std::vector<uint16_t> forward_values;
-  std::vector<std::size_t> forward_end;
+  // Adds the common sums of every slot that shares a word with the query,
+  // from the postings of the query's words.
+  void AccumulatePostings(const PreparedQuery& q, CommonSums* sum) const {
+    const Float2* value = values.data();
+    for (std::size_t i = 0; i < q.words.size(); ++i) {
+      const Postings& p = postings[q.words[i]];
+      // (x, g(x)) of the query word: lane 0 multiplies the model's g, lane 1
+      // its weight. Both products of floats are exact in double.
+      const Double2 factor{static_cast<double>(q.weights[i]), static_cast<double>(q.g[i])};
+      const uint16_t* slots = p.slots.data();
+      const uint16_t* ids = p.values.data();
+      const std::size_t m = p.slots.size();
+      std::size_t j = 0;
+      for (; j + 4 <= m; j += 4) {  // four independent slots at a time
+        const Double2 v0 = __builtin_convertvector(value[ids[j]], Double2) * factor;
+        const Double2 v1 = __builtin_convertvector(value[ids[j + 1]], Double2) * factor;
+        const Double2 v2 = __builtin_convertvector(value[ids[j + 2]], Double2) * factor;
+        const Double2 v3 = __builtin_convertvector(value[ids[j + 3]], Double2) * factor;
+        sum[slots[j]] += v0;
+        sum[slots[j + 1]] += v1;
+        sum[slots[j + 2]] += v2;
+        sum[slots[j + 3]] += v3;
+      }
+      for (; j < m; ++j) sum[slots[j]] += __builtin_convertvector(value[ids[j]], Double2) * factor;
+    }
+  }
+
+  std::vector<Postings> postings;  // per word; empty once dropped
+  // Per slot, where its forward entries are in the index's ForwardStore.
+  std::vector<uint64_t> forward_offset;
+  std::vector<uint32_t> forward_count;
   // The value dictionary: per value id its float-rounded g and the weight,
   // side by side so that a posting loads both at once.
   std::vector<Float2> values;
@@ -130,20 +219,36 @@ struct KlInvertedIndex::Segment {
   std::size_t dead = 0;
 };
 
-KlInvertedIndex::KlInvertedIndex(uint32_t vocabulary, const KlDivergenceOptions& options)
-    : vocabulary_(vocabulary), options_(options) {}
+absl::Status KlIndexStorage::Check() const {
+  if (postings_max_models == 0) {
+    return absl::InvalidArgumentError("KlIndexStorage: postings_max_models must be at least 1");
+  }
+  return absl::OkStatus();
+}
+
+KlInvertedIndex::KlInvertedIndex(uint32_t vocabulary,
+                                 const KlDivergenceOptions& options,
+                                 const KlIndexStorage& storage,
+                                 std::unique_ptr<ForwardStore> forward)
+    : vocabulary_(vocabulary), options_(options), storage_(storage), forward_(std::move(forward)) {}
 KlInvertedIndex::KlInvertedIndex(KlInvertedIndex&&) noexcept = default;
 KlInvertedIndex& KlInvertedIndex::operator=(KlInvertedIndex&&) noexcept = default;
 KlInvertedIndex::~KlInvertedIndex() = default;
 
 absl::StatusOr<KlInvertedIndex> KlInvertedIndex::Create(uint32_t vocabulary,
-                                                        const KlDivergenceOptions& options) {
+                                                        const KlDivergenceOptions& options,
+                                                        const KlIndexStorage& storage) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
+  MESHSEEK_RETURN_IF_ERROR(storage.Check());
   if (vocabulary == 0 || vocabulary > kMaxVocabulary) {
     return absl::InvalidArgumentError(absl::StrCat("KlInvertedIndex: vocabulary ", vocabulary,
                                                    " is not in [1, ", kMaxVocabulary, "]"));
   }
-  return KlInvertedIndex(vocabulary, options);
+  std::unique_ptr<ForwardStore> forward = ForwardStore::InMemory();
+  if (!storage.forward_dir.empty()) {
+    MESHSEEK_ASSIGN_OR_RETURN(forward, ForwardStore::InFile(storage.forward_dir));
+  }
+  return KlInvertedIndex(vocabulary, options, storage, std::move(forward));
 }
 
 absl::StatusOr<KlInvertedIndex::PreparedQuery> KlInvertedIndex::Prepare(
@@ -172,18 +277,27 @@ absl::StatusOr<KlInvertedIndex::PreparedQuery> KlInvertedIndex::Prepare(
   return q;
 }
 
-void KlInvertedIndex::Append(uint32_t doc, const PreparedQuery& q) {
+absl::Status KlInvertedIndex::Append(uint32_t doc, const PreparedQuery& q) {
   if (segments_.empty() || segments_.back()->docs.size() == kSegmentSlots ||
       !segments_.back()->Fits(q)) {
-    segments_.push_back(std::make_unique<Segment>(vocabulary_));
+    segments_.push_back(std::make_unique<Segment>(vocabulary_, postings_));
   }
   Segment& seg = *segments_.back();
-  locations_[doc] =
-      Location{static_cast<uint32_t>(segments_.size() - 1), static_cast<uint16_t>(seg.docs.size())};
-  seg.Add(doc, q);
+  const Location at{static_cast<uint32_t>(segments_.size() - 1),
+                    static_cast<uint16_t>(seg.docs.size())};
+  MESHSEEK_RETURN_IF_ERROR(seg.Add(doc, q, forward_.get()));
+  locations_[doc] = at;
+  live_entries_ += q.words.size();
+  if (postings_ && size() > storage_.postings_max_models) {
+    // Large: scans read the forward entries (see "Storage" in the header).
+    postings_ = false;
+    for (const auto& segment : segments_) segment->DropPostings();
+    ReturnFreedMemory();
+  }
   // Models without words have no distance to anything: never proposed.
   if (candidates_.has_value() && !q.empty()) candidates_->Add(doc, q.embedding);
   if (!embedding_ && size() >= kEmbeddingFitModels) FitEmbedding();
+  return absl::OkStatus();
 }
 
 void KlInvertedIndex::Embed(PreparedQuery* q) const {
@@ -205,18 +319,23 @@ void KlInvertedIndex::FitEmbedding() {
   for (const auto& seg : segments_) {
     for (std::size_t slot = 0; slot < seg->docs.size(); ++slot) {
       if (!seg->live[slot] || seg->empty[slot]) continue;
-      PreparedQuery q = seg->Stored(slot);
+      PreparedQuery q = seg->Stored(slot, *forward_);
       Embed(&q);
       candidates_->Add(seg->docs[slot], q.embedding);
     }
   }
+  ReturnFreedMemory();  // the fit's sample and work matrices: ~0.5 GB at V = 40,000
 }
 
 absl::Status KlInvertedIndex::Upsert(uint32_t doc, const SparseHistogram& histogram) {
   MESHSEEK_ASSIGN_OR_RETURN(const PreparedQuery prepared,
                             Prepare(histogram, absl::StrCat("model ", doc)));
-  Remove(doc);
-  Append(doc, prepared);
+  // The new copy first: a failed append leaves the old one in place.
+  const auto old = locations_.find(doc);
+  const std::optional<Location> was =
+      old != locations_.end() ? std::optional<Location>(old->second) : std::nullopt;
+  MESHSEEK_RETURN_IF_ERROR(Append(doc, prepared));
+  if (was.has_value()) RemoveSlot(*was);
   return absl::OkStatus();
 }
 
@@ -226,25 +345,68 @@ bool KlInvertedIndex::Remove(uint32_t doc) {
   const Location at = it->second;
   locations_.erase(it);
   if (candidates_.has_value()) candidates_->Remove(doc);
+  RemoveSlot(at);
+  return true;
+}
+
+void KlInvertedIndex::RemoveSlot(Location at) {
   Segment& seg = *segments_[at.segment];
   seg.live[at.slot] = 0;
   ++seg.dead;
+  live_entries_ -= seg.forward_count[at.slot];
   if (seg.dead * 2 > seg.docs.size()) CompactSegment(at.segment);
-  return true;
+  // Entries of dead models outnumber the live ones: rewrite the store.
+  if (forward_->size() > 2 * live_entries_ + (1u << 20)) RewriteForward();
 }
 
 void KlInvertedIndex::CompactSegment(std::size_t s) {
   // Rebuilds segment s from its live slots, in slot order: slots change,
-  // docs and values do not. The rebuilt segment replaces s in place.
+  // docs, values and forward entries do not (the dictionary is kept). The
+  // rebuilt segment replaces s in place.
   const Segment& old = *segments_[s];
-  auto rebuilt = std::make_unique<Segment>(vocabulary_);
+  auto rebuilt = std::make_unique<Segment>(vocabulary_, old.has_postings());
+  rebuilt->values = old.values;
+  rebuilt->value_ids = old.value_ids;
+  std::vector<uint32_t> buffer;
   for (std::size_t slot = 0; slot < old.docs.size(); ++slot) {
     if (!old.live[slot]) continue;
     locations_[old.docs[slot]] =
         Location{static_cast<uint32_t>(s), static_cast<uint16_t>(rebuilt->docs.size())};
-    rebuilt->Add(old.docs[slot], old.Stored(slot));
+    rebuilt->AddSlot(old.docs[slot], old.forward_offset[slot], old.Entries(slot, *forward_, &buffer),
+                     old.empty[slot], old.c[slot], old.e[slot], old.a[slot], old.big_g[slot]);
   }
   segments_[s] = std::move(rebuilt);
+}
+
+void KlInvertedIndex::RewriteForward() {
+  // The live slots' entries into a new store of the same kind, in segment
+  // and slot order; on a write error the old store stays (it is whole).
+  std::unique_ptr<ForwardStore> fresh = ForwardStore::InMemory();
+  if (forward_->in_file()) {
+    absl::StatusOr<std::unique_ptr<ForwardStore>> file = ForwardStore::InFile(storage_.forward_dir);
+    if (!file.ok()) return;
+    fresh = *std::move(file);
+  }
+  std::vector<std::vector<uint64_t>> offsets(segments_.size());
+  std::vector<uint32_t> buffer;
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    const Segment& seg = *segments_[s];
+    offsets[s].assign(seg.docs.size(), 0);
+    for (std::size_t slot = 0; slot < seg.docs.size(); ++slot) {
+      if (!seg.live[slot]) continue;
+      absl::StatusOr<uint64_t> at = fresh->Append(seg.Entries(slot, *forward_, &buffer));
+      if (!at.ok()) return;
+      offsets[s][slot] = *at;
+    }
+  }
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    Segment& seg = *segments_[s];
+    for (std::size_t slot = 0; slot < seg.docs.size(); ++slot) {
+      seg.forward_offset[slot] = offsets[s][slot];
+      if (!seg.live[slot]) seg.forward_count[slot] = 0;
+    }
+  }
+  forward_ = std::move(fresh);
 }
 
 namespace {
@@ -265,7 +427,7 @@ void KlInvertedIndex::ForEach(
   for (const auto& seg : segments_) {
     for (std::size_t slot = 0; slot < seg->docs.size(); ++slot) {
       if (!seg->live[slot]) continue;
-      PreparedQuery q = seg->Stored(slot);
+      PreparedQuery q = seg->Stored(slot, *forward_);
       fn(seg->docs[slot], ToHistogram(vocabulary_, std::move(q.words), std::move(q.weights)));
     }
   }
@@ -276,7 +438,7 @@ absl::StatusOr<SparseHistogram> KlInvertedIndex::Histogram(uint32_t doc) const {
   if (it == locations_.end()) {
     return absl::NotFoundError(absl::StrCat("model ", doc, " is not in the index"));
   }
-  PreparedQuery q = segments_[it->second.segment]->Stored(it->second.slot);
+  PreparedQuery q = segments_[it->second.segment]->Stored(it->second.slot, *forward_);
   return ToHistogram(vocabulary_, std::move(q.words), std::move(q.weights));
 }
 
@@ -290,7 +452,10 @@ double KlInvertedIndex::Combine(const PreparedQuery& q,
 }
 
 template <typename Emit>
-void KlInvertedIndex::ScanSegment(const PreparedQuery& q, std::size_t s, Emit&& emit) const {
+void KlInvertedIndex::ScanSegment(const PreparedQuery& q,
+                                  const DenseQuery* dense,
+                                  std::size_t s,
+                                  Emit&& emit) const {
   const Segment& seg = *segments_[s];
   const std::size_t n = seg.docs.size();
   if (q.empty()) {
@@ -301,28 +466,17 @@ void KlInvertedIndex::ScanSegment(const PreparedQuery& q, std::size_t s, Emit&& 
   }
   std::vector<CommonSums>& sums = Scratch();
   sums.assign(n, CommonSums{0.0, 0.0});
-  const Float2* values = seg.values.data();
-  CommonSums* sum = sums.data();
-  for (std::size_t i = 0; i < q.words.size(); ++i) {
-    const Segment::Postings& p = seg.postings[q.words[i]];
-    // (x, g(x)) of the query word: lane 0 multiplies the model's g, lane 1
-    // its weight. Both products of floats are exact in double.
-    const Double2 factor{static_cast<double>(q.weights[i]), static_cast<double>(q.g[i])};
-    const uint16_t* slots = p.slots.data();
-    const uint16_t* ids = p.values.data();
-    const std::size_t m = p.slots.size();
-    std::size_t j = 0;
-    for (; j + 4 <= m; j += 4) {  // four independent slots at a time
-      const Double2 v0 = __builtin_convertvector(values[ids[j]], Double2) * factor;
-      const Double2 v1 = __builtin_convertvector(values[ids[j + 1]], Double2) * factor;
-      const Double2 v2 = __builtin_convertvector(values[ids[j + 2]], Double2) * factor;
-      const Double2 v3 = __builtin_convertvector(values[ids[j + 3]], Double2) * factor;
-      sum[slots[j]] += v0;
-      sum[slots[j + 1]] += v1;
-      sum[slots[j + 2]] += v2;
-      sum[slots[j + 3]] += v3;
+  if (!seg.has_postings()) {
+    // Every live model's forward entries against the dense query: the same
+    // doubles, O(the segment's entries) instead of O(the query's postings).
+    std::vector<uint32_t> buffer;
+    for (std::size_t slot = 0; slot < n; ++slot) {
+      if (seg.live[slot] && !seg.empty[slot]) {
+        sums[slot] = seg.ForwardSums(seg.Entries(slot, *forward_, &buffer), *dense);
+      }
     }
-    for (; j < m; ++j) sum[slots[j]] += __builtin_convertvector(values[ids[j]], Double2) * factor;
+  } else {
+    seg.AccumulatePostings(q, sums.data());
   }
   for (std::size_t slot = 0; slot < n; ++slot) {
     if (!seg.live[slot]) continue;
@@ -350,9 +504,12 @@ std::vector<KlNeighbor> KlInvertedIndex::AllDistances(const PreparedQuery& q,
     offsets[s + 1] = offsets[s] + segments_[s]->docs.size() - segments_[s]->dead;
   }
   std::vector<KlNeighbor> out(offsets.back());
+  const std::optional<DenseQuery> dense =
+      postings_ ? std::nullopt : std::optional<DenseQuery>(DenseQuery(q, vocabulary_));
   ParallelFor(segments_.size(), num_threads, [&](std::size_t s) {
     std::size_t at = offsets[s];
-    ScanSegment(q, s, [&](uint32_t doc, float d) { out[at++] = KlNeighbor{doc, d}; });
+    ScanSegment(q, dense ? &*dense : nullptr, s,
+                [&](uint32_t doc, float d) { out[at++] = KlNeighbor{doc, d}; });
   });
   return out;
 }
@@ -371,22 +528,11 @@ std::vector<KlNeighbor> KlInvertedIndex::RerankCandidates(const PreparedQuery& q
 std::vector<KlNeighbor> KlInvertedIndex::ForwardDistances(const PreparedQuery& q,
                                                           const std::vector<Location>& at,
                                                           int num_threads) const {
-  // The query as dense arrays, zero off its words, so that each model's
-  // words are summed in word order with zero terms elsewhere: the same
-  // doubles as the scan.
-  thread_local std::vector<double> dense_x, dense_g;
-  dense_x.assign(vocabulary_, 0.0);
-  dense_g.assign(vocabulary_, 0.0);
-  for (std::size_t i = 0; i < q.words.size(); ++i) {
-    dense_x[q.words[i]] = q.weights[i];
-    dense_g[q.words[i]] = q.g[i];
-  }
-  // Read-only from here: the threads share them.
-  const double* x = dense_x.data();
-  const double* gx = dense_g.data();
+  const DenseQuery dense(q, vocabulary_);  // read-only from here: the threads share it
   std::vector<KlNeighbor> out(at.size());
   constexpr std::size_t kPerTask = 256;
   ParallelFor((at.size() + kPerTask - 1) / kPerTask, num_threads, [&](std::size_t task) {
+    std::vector<uint32_t> buffer;
     const std::size_t end = std::min(at.size(), (task + 1) * kPerTask);
     for (std::size_t c = task * kPerTask; c < end; ++c) {
       const Segment& seg = *segments_[at[c].segment];
@@ -395,15 +541,8 @@ std::vector<KlNeighbor> KlInvertedIndex::ForwardDistances(const PreparedQuery& q
         out[c] = {seg.docs[slot], kInfinity};
         continue;
       }
-      double query_side = 0.0, model_side = 0.0;
-      const std::size_t first = slot == 0 ? 0 : seg.forward_end[slot - 1];
-      for (std::size_t i = first; i < seg.forward_end[slot]; ++i) {
-        const uint16_t word = seg.forward_words[i];
-        const Float2 value = seg.values[seg.forward_values[i]];
-        query_side += x[word] * static_cast<double>(value[0]);
-        model_side += static_cast<double>(value[1]) * gx[word];
-      }
-      const double distance = Combine(q, seg, slot, query_side, model_side);
+      const CommonSums sums = seg.ForwardSums(seg.Entries(slot, *forward_, &buffer), dense);
+      const double distance = Combine(q, seg, slot, sums[0], sums[1]);
       out[c] = {seg.docs[slot], distance > 0.0 ? static_cast<float>(distance) : 0.0f};
     }
   });
@@ -459,7 +598,7 @@ absl::StatusOr<KlInvertedIndex::PreparedQuery> KlInvertedIndex::StoredQuery(uint
   if (it == locations_.end()) {
     return absl::NotFoundError(absl::StrCat("model ", doc, " is not in the index"));
   }
-  PreparedQuery q = segments_[it->second.segment]->Stored(it->second.slot);
+  PreparedQuery q = segments_[it->second.segment]->Stored(it->second.slot, *forward_);
   // The embedding the candidate index holds is the one Prepare computes.
   if (embedded && candidates_.has_value() && !q.empty()) {
     MESHSEEK_ASSIGN_OR_RETURN(q.embedding, candidates_->Vector(doc));
@@ -503,10 +642,12 @@ absl::StatusOr<std::vector<float>> KlInvertedIndex::DistanceMatrix(const std::ve
   std::vector<float> matrix(n * n, kInfinity);
   ParallelFor(n, num_threads, [&](std::size_t i) {
     const Location at = locations_.at(docs[i]);
-    const PreparedQuery q = segments_[at.segment]->Stored(at.slot);
+    const PreparedQuery q = segments_[at.segment]->Stored(at.slot, *forward_);
+    const std::optional<DenseQuery> dense =
+        postings_ ? std::nullopt : std::optional<DenseQuery>(DenseQuery(q, vocabulary_));
     float* row = &matrix[i * n];
     for (std::size_t s = 0; s < segments_.size(); ++s) {
-      ScanSegment(q, s, [&](uint32_t doc, float d) {
+      ScanSegment(q, dense ? &*dense : nullptr, s, [&](uint32_t doc, float d) {
         auto it = column.find(doc);
         if (it != column.end()) row[it->second] = d;
       });
@@ -516,18 +657,21 @@ absl::StatusOr<std::vector<float>> KlInvertedIndex::DistanceMatrix(const std::ve
   return matrix;
 }
 
+uint64_t KlInvertedIndex::FileBytes() const { return forward_->FileBytes(); }
+
 std::size_t KlInvertedIndex::MemoryBytes() const {
   std::size_t bytes = sizeof(*this) +
                       (embedding_ ? vocabulary_ * kEmbeddingDimensions * sizeof(float) : 0) +
                       (candidates_.has_value() ? candidates_->MemoryBytes() : 0) +
+                      forward_->MemoryBytes() +
                       locations_.capacity() * (sizeof(uint32_t) + sizeof(Location) + 1);
   for (const auto& seg : segments_) {
-    bytes += sizeof(Segment) + seg->postings.capacity() * sizeof(Segment::Postings);
+    bytes += sizeof(Segment) + seg->postings.capacity() * sizeof(Segment::Postings) +
+             seg->forward_offset.capacity() * sizeof(uint64_t) +
+             seg->forward_count.capacity() * sizeof(uint32_t);
     for (const Segment::Postings& p : seg->postings) {
       bytes += (p.slots.capacity() + p.values.capacity()) * sizeof(uint16_t);
     }
-    bytes += (seg->forward_words.capacity() + seg->forward_values.capacity()) * sizeof(uint16_t) +
-             seg->forward_end.capacity() * sizeof(std::size_t);
     bytes += seg->values.capacity() * sizeof(Float2) +
              seg->value_ids.capacity() * (sizeof(uint32_t) + sizeof(uint16_t) + 1);
     bytes += seg->docs.capacity() * sizeof(uint32_t) + seg->live.capacity() + seg->empty.capacity() +

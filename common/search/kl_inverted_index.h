@@ -87,6 +87,20 @@
 // forward index as large as the postings, about 800 bytes of embedding and
 // graph links per model.
 //
+// Storage (issue 37: memory that does not grow with the vocabulary). The
+// forward index lives in a ForwardStore (forward_store.h): in memory, or in
+// an unlinked file read with pread (KlIndexStorage::forward_dir), 4 bytes an
+// entry either way; the process then keeps 12 bytes of offsets a model.
+// Postings are kept while the index holds at most
+// KlIndexStorage::postings_max_models models; past that they are freed and
+// a full scan reads every live model's forward entries against the query as
+// dense arrays: the same doubles (each model's words in word order, zero
+// terms elsewhere), so every distance stays bit for bit the one the postings
+// give, at O(all entries) instead of O(the query's postings). That is the
+// trade a service makes for a collection too large to scan often: its
+// queries go through candidates, and its builds ask full rows only for the
+// scale's sample (docs/design.md 4.4).
+//
 // Models without words (no local features) have no distance to anything: +inf
 // to every other model, and as a query every distance is +inf (0 only from a
 // model to itself in the all-pairs matrix), the rule of the pipeline.
@@ -100,8 +114,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "absl/container/flat_hash_map.h"
@@ -114,6 +130,21 @@
 #include "common/search/sparse_histogram.h"
 
 namespace meshseek {
+
+class ForwardStore;
+
+/// Where a KlInvertedIndex keeps what grows with its models (see "Storage").
+struct KlIndexStorage {
+  /// Folder of the forward index's file (an unlinked temporary: nothing to
+  /// clean up or check after a crash); empty: in memory.
+  std::string forward_dir;
+  /// Postings are freed once the index holds more models than this; the
+  /// default keeps them always. The index service sets 20,000
+  /// (index_service.h). At least 1.
+  std::size_t postings_max_models = std::numeric_limits<std::size_t>::max();
+
+  absl::Status Check() const;
+};
 
 /// One model's distance to a query. `doc` is the caller's id of the model.
 struct KlNeighbor {
@@ -132,9 +163,11 @@ class KlInvertedIndex {
   static constexpr std::size_t kEmbeddingFitModels = 2048;
 
   /// An empty index for histograms over `vocabulary` words; InvalidArgument
-  /// for vocabulary 0 or invalid options.
+  /// for vocabulary 0 or invalid options, Internal when the forward file
+  /// cannot be made.
   static absl::StatusOr<KlInvertedIndex> Create(uint32_t vocabulary,
-                                                const KlDivergenceOptions& options = {});
+                                                const KlDivergenceOptions& options = {},
+                                                const KlIndexStorage& storage = {});
 
   KlInvertedIndex(KlInvertedIndex&&) noexcept;
   KlInvertedIndex& operator=(KlInvertedIndex&&) noexcept;
@@ -142,19 +175,23 @@ class KlInvertedIndex {
 
   uint32_t vocabulary() const { return vocabulary_; }
   const KlDivergenceOptions& options() const { return options_; }
+  const KlIndexStorage& storage() const { return storage_; }
+  /// Whether postings are kept (see "Storage").
+  bool has_postings() const { return postings_; }
   /// Number of models.
   std::size_t size() const { return locations_.size(); }
   bool Contains(uint32_t doc) const { return locations_.contains(doc); }
 
   /// Adds model `doc` with `histogram`, replacing what `doc` held before.
   /// InvalidArgument (naming `doc`) for a histogram that fails Validate() or
-  /// has another vocabulary; the index is then unchanged.
+  /// has another vocabulary, Internal when the forward file cannot grow; the
+  /// index is then unchanged.
   absl::Status Upsert(uint32_t doc, const SparseHistogram& histogram);
   /// Removes `doc`; false when it was not there.
   bool Remove(uint32_t doc);
 
   /// Calls fn(doc, histogram) for every model, the histogram exactly as it
-  /// was given; reads the postings one segment at a time.
+  /// was given, from the forward index.
   void ForEach(const std::function<void(uint32_t, const SparseHistogram&)>& fn) const;
 
   /// The histogram stored for `doc`, exactly as it was given, or NotFound;
@@ -213,6 +250,8 @@ class KlInvertedIndex {
 
   /// Bytes held by postings, constants and bookkeeping (capacity, not size).
   std::size_t MemoryBytes() const;
+  /// Bytes of the forward index's file (0 in memory).
+  uint64_t FileBytes() const;
 
  private:
   struct Segment;
@@ -223,8 +262,13 @@ class KlInvertedIndex {
   // A histogram prepared once: words, weights, float-rounded g and the
   // constants c, e, a, G of the formula above.
   struct PreparedQuery;
+  // A prepared query as dense arrays (forward sums).
+  struct DenseQuery;
 
-  KlInvertedIndex(uint32_t vocabulary, const KlDivergenceOptions& options);
+  KlInvertedIndex(uint32_t vocabulary,
+                  const KlDivergenceOptions& options,
+                  const KlIndexStorage& storage,
+                  std::unique_ptr<ForwardStore> forward);
   absl::StatusOr<PreparedQuery> Prepare(const SparseHistogram& histogram,
                                         absl::string_view name) const;
   // Stored model `doc` as a prepared query, with its embedding if asked.
@@ -252,13 +296,21 @@ class KlInvertedIndex {
                         double query_side,
                         double model_side);
   // Appends a prepared histogram to the last segment (a new one when full),
-  // fitting the embedding when the index reaches kEmbeddingFitModels.
-  void Append(uint32_t doc, const PreparedQuery& prepared);
+  // fitting the embedding when the index reaches kEmbeddingFitModels and
+  // freeing the postings past postings_max_models; unchanged on an error.
+  absl::Status Append(uint32_t doc, const PreparedQuery& prepared);
+  // Marks a slot dead, compacting its segment or the forward store when
+  // dead entries outnumber live ones.
+  void RemoveSlot(Location at);
+  // The live slots' forward entries into a new store (kept on an error).
+  void RewriteForward();
   // q's embedding (embedding_ is fitted).
   void Embed(PreparedQuery* q) const;
-  // Calls emit(doc, distance) for every live model of segment `s`.
+  // Calls emit(doc, distance) for every live model of segment `s`, from its
+  // postings, or from its forward entries and `dense` when they are freed.
   template <typename Emit>
-  void ScanSegment(const PreparedQuery& query, std::size_t s, Emit&& emit) const;
+  void ScanSegment(const PreparedQuery& query, const DenseQuery* dense, std::size_t s,
+                   Emit&& emit) const;
   void CompactSegment(std::size_t s);
 
   uint32_t vocabulary_ = 0;
@@ -267,6 +319,10 @@ class KlInvertedIndex {
   std::optional<HistogramEmbedding> embedding_;
   // The embeddings of the models with words, with the embedding.
   std::optional<CandidateIndex> candidates_;
+  KlIndexStorage storage_;
+  std::unique_ptr<ForwardStore> forward_;
+  uint64_t live_entries_ = 0;  // forward entries of live models
+  bool postings_ = true;       // false once freed (see "Storage")
   std::vector<std::unique_ptr<Segment>> segments_;
   absl::flat_hash_map<uint32_t, Location> locations_;
 };

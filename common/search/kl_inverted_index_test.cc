@@ -287,6 +287,71 @@ TEST(KlInvertedIndexTest, StoredModelsAsQueriesGiveTheirHistogramsAnswersBitForB
             absl::StatusCode::kNotFound);
 }
 
+// Every answer of `a` and `b` over the docs < n, bit for bit.
+void ExpectSameAnswers(const KlInvertedIndex& a, const KlInvertedIndex& b,
+                       const std::vector<std::vector<float>>& queries, std::size_t n) {
+  ASSERT_EQ(a.size(), b.size());
+  std::vector<uint32_t> docs;
+  for (uint32_t d = 0; d < n; ++d) {
+    if (a.Contains(d)) docs.push_back(d);
+  }
+  for (const auto& dense : queries) {
+    const SparseHistogram q = SparseFromDense(dense);
+    EXPECT_EQ(ByDoc(*a.Distances(q, 2), n), ByDoc(*b.Distances(q, 1), n));
+    const auto x = a.Search(q, 10, 1, 40), y = b.Search(q, 10, 2, 40);
+    ASSERT_EQ(x->size(), y->size());
+    for (std::size_t i = 0; i < x->size(); ++i) {
+      EXPECT_EQ((*x)[i].doc, (*y)[i].doc);
+      EXPECT_EQ((*x)[i].distance, (*y)[i].distance);
+    }
+    EXPECT_EQ(ByDoc(*a.DistancesTo(q, docs, 1), n), ByDoc(*b.DistancesTo(q, docs, 2), n));
+  }
+  const std::vector<uint32_t> some(docs.begin(), docs.begin() + std::min<std::size_t>(docs.size(), 30));
+  EXPECT_EQ(*a.DistanceMatrix(some, 1), *b.DistanceMatrix(some, 2));
+  for (uint32_t d : some) {
+    EXPECT_EQ(a.Histogram(d)->words, b.Histogram(d)->words);
+    EXPECT_EQ(a.Histogram(d)->weights, b.Histogram(d)->weights);
+  }
+}
+
+TEST(KlInvertedIndexTest, AForwardFileWithoutPostingsAnswersBitForBitAsMemory) {
+  // Past the fit, with replacements and removals enough to compact segments
+  // and rewrite the forward file (its dead entries past a million).
+  const std::size_t n = 1600;
+  const auto first = CountHistograms(n, 1000, 2400, 31);
+  const auto second = CountHistograms(n, 1000, 2400, 32);
+  KlIndexStorage storage;
+  storage.forward_dir = ::testing::TempDir() + "/forward";
+  storage.postings_max_models = 500;
+  KlInvertedIndex memory = *KlInvertedIndex::Create(1000);
+  KlInvertedIndex file = *KlInvertedIndex::Create(1000, {}, storage);
+  for (KlInvertedIndex* index : {&memory, &file}) {
+    for (uint32_t d = 0; d < n; ++d) ASSERT_TRUE(index->Upsert(d, SparseFromDense(first[d])).ok());
+  }
+  EXPECT_TRUE(memory.has_postings());
+  EXPECT_FALSE(file.has_postings());
+  EXPECT_GT(file.FileBytes(), 0u);
+  EXPECT_EQ(memory.FileBytes(), 0u);
+  EXPECT_LT(file.MemoryBytes(), memory.MemoryBytes() / 3);
+  const std::vector<std::vector<float>> queries = {first[3], second[7], CountHistograms(1, 1000, 2400, 99)[0]};
+  ExpectSameAnswers(memory, file, queries, n);
+  const uint64_t grown = file.FileBytes();
+  for (KlInvertedIndex* index : {&memory, &file}) {
+    for (uint32_t d = 0; d < n; ++d) ASSERT_TRUE(index->Upsert(d, SparseFromDense(second[d])).ok());
+    for (uint32_t d = 0; d < n; ++d) {
+      if (d % 8 != 0) ASSERT_TRUE(index->Remove(d));
+    }
+  }
+  EXPECT_LT(file.FileBytes(), grown);  // rewritten without the dead entries
+  ExpectSameAnswers(memory, file, queries, n);
+  KlIndexStorage bad;
+  bad.postings_max_models = 0;
+  EXPECT_EQ(KlInvertedIndex::Create(10, {}, bad).status().code(), absl::StatusCode::kInvalidArgument);
+  bad = {};
+  bad.forward_dir = "/proc/no/such/folder";
+  EXPECT_EQ(KlInvertedIndex::Create(10, {}, bad).status().code(), absl::StatusCode::kInternal);
+}
+
 TEST(KlInvertedIndexTest, CandidatesBeforeTheEmbeddingIsFittedSearchExactly) {
   const auto dense = CountHistograms(300, 200, 600, 22);
   const KlInvertedIndex index = MakeIndex(dense);

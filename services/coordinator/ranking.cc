@@ -6,6 +6,7 @@
 #include <limits>
 #include <tuple>
 
+#include "absl/container/flat_hash_map.h"
 #include "absl/strings/str_cat.h"
 #include "common/base/byte_order.h"
 #include "common/base/hash.h"
@@ -346,79 +347,105 @@ std::vector<IndexShards::Part> IndexParts(const CollectionPlan& plan) {
   return parts;
 }
 
+namespace {
+
+// Each part's distance scale over the sample rows (fusion.h): whole rows up
+// to kScaleColumns models, in the order ScaleSampleRows lists them; above,
+// their exact distances to the sampled columns, 32 rows a call.
+absl::StatusOr<std::vector<double>> EstimateScales(IndexShards* index,
+                                                   const std::vector<IndexShards::Part>& parts,
+                                                   const IndexShards::PartModels& models) {
+  const std::size_t n = models.size();
+  std::vector<std::size_t> sample = ScaleSampleRows(n);
+  std::vector<DistanceScale> scales(parts.size());
+  if (n <= kScaleColumns) {
+    std::size_t seen = 0;
+    MESHSEEK_RETURN_IF_ERROR(index->ForEachDistanceRow(
+        parts,
+        [&](const IndexShards::Row& row) -> absl::Status {
+          for (std::size_t p = 0; p < parts.size(); ++p) scales[p].AddRow(sample[seen], row.distances[p]);
+          ++seen;
+          return absl::OkStatus();
+        },
+        &sample));
+  } else {
+    const std::vector<std::size_t> columns = ScaleSampleColumns(n);
+    std::vector<std::string> column_ids;
+    absl::flat_hash_map<std::string, std::size_t> column_of;
+    for (std::size_t c : columns) {
+      column_of[models.models[0][c].model_id()] = column_ids.size();
+      column_ids.push_back(models.models[0][c].model_id());
+    }
+    constexpr std::size_t kRowsPerCall = 32;
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      for (std::size_t begin = 0; begin < sample.size(); begin += kRowsPerCall) {
+        const std::size_t end = std::min(sample.size(), begin + kRowsPerCall);
+        std::vector<std::string> ids;
+        for (std::size_t r = begin; r < end; ++r) ids.push_back(models.models[0][sample[r]].model_id());
+        MESHSEEK_ASSIGN_OR_RETURN(
+            const auto got,
+            index->PairDistances(parts[p], ids,
+                                 std::vector<std::vector<std::string>>(ids.size(), column_ids)));
+        for (std::size_t r = begin; r < end; ++r) {
+          // A model removed since the export is left out (+inf: skipped).
+          std::vector<float> row(columns.size(), std::numeric_limits<float>::infinity());
+          for (const IndexShards::Scored& s : got[r - begin]) row[column_of.at(s.model_id)] = s.distance;
+          const auto self = std::lower_bound(columns.begin(), columns.end(), sample[r]);
+          scales[p].AddRow(self != columns.end() && *self == sample[r] ? self - columns.begin()
+                                                                       : columns.size(),
+                           row);
+        }
+      }
+    }
+  }
+  std::vector<double> out;
+  for (const DistanceScale& s : scales) out.push_back(s.Scale());
+  return out;
+}
+
+}  // namespace
+
 absl::StatusOr<RankingState> ComputeRankingState(IndexShards* index,
                                                  const CollectionPlan& plan,
                                                  const RankingGraphOptions& graph_options) {
   const std::vector<IndexShards::Part> parts = IndexParts(plan);
   const CollectionOptions& options = plan.options;
   RankingState state;
-  // Pass 1: every model in order, and each method's scale over the sample
-  // rows (the rows come in the order ScaleSampleRows lists them).
-  std::vector<DistanceScale> scales(parts.size());
-  std::size_t n = 0;
-  {
-    // The models first: their number fixes the sample rows.
-    std::vector<std::size_t> first_row = {0};
-    MESHSEEK_RETURN_IF_ERROR(index->ForEachDistanceRow(
-        parts,
-        [&](const IndexShards::Row& row) -> absl::Status {
-          n = row.distances.front().size();
-          return absl::OkStatus();
-        },
-        &first_row));
-  }
-  std::vector<std::size_t> sample = ScaleSampleRows(n);
-  std::size_t seen = 0;
-  MESHSEEK_RETURN_IF_ERROR(index->ForEachDistanceRow(
-      parts,
-      [&](const IndexShards::Row& row) -> absl::Status {
-        for (std::size_t p = 0; p < parts.size(); ++p)
-          scales[p].AddRow(sample[seen], row.distances[p]);
-        ++seen;
-        return absl::OkStatus();
-      },
-      &sample));
-  for (const DistanceScale& s : scales) state.scales.push_back(s.Scale());
+  // Pass 1: the models (ids only), and each method's scale.
+  MESHSEEK_ASSIGN_OR_RETURN(const IndexShards::PartModels models,
+                            index->ExportParts(parts, /*signatures=*/false));
+  const std::size_t n = models.size();
+  MESHSEEK_ASSIGN_OR_RETURN(state.scales, EstimateScales(index, parts, models));
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<double> factors,
                             FusionFactors(options.weights, state.scales));
-  // Pass 2: the models, and the graph of the fused rows: from candidates
-  // above the exact graph's size (fused_candidates.h).
-  if (options.rerank.enabled() && n > graph_options.exact_graph_models) {
-    MESHSEEK_ASSIGN_OR_RETURN(const IndexShards::PartModels models,
-                              index->ExportParts(parts, /*signatures=*/false));
-    if (models.size() != n) {
-      return absl::AbortedError("the collection changed during its build; build again");
-    }
-    for (const v1::IndexedModel& m : models.models[0]) {
-      state.model_ids.push_back(m.model_id());
-      state.ordinals.push_back(m.ordinal());
-      state.labels.push_back(m.label());
-    }
+  for (const v1::IndexedModel& m : models.models[0]) {
+    state.model_ids.push_back(m.model_id());
+    state.ordinals.push_back(m.ordinal());
+    state.labels.push_back(m.label());
+  }
+  if (!options.rerank.enabled()) return state;
+  // Pass 2: the graph of the fused rows, from candidates above the exact
+  // graph's size (fused_candidates.h).
+  if (n > graph_options.exact_graph_models) {
     MESHSEEK_ASSIGN_OR_RETURN(state.graph,
                               ApproximateNeighborGraph(index, plan, models, factors,
                                                        options.rerank.graph_k(), graph_options));
     return state;
   }
-  if (options.rerank.enabled()) {
-    MESHSEEK_ASSIGN_OR_RETURN(state.graph, NeighborGraph::Create(n, options.rerank.graph_k()));
-  }
+  MESHSEEK_ASSIGN_OR_RETURN(state.graph, NeighborGraph::Create(n, options.rerank.graph_k()));
   std::vector<float> fused(n);
+  std::size_t i = 0;
   MESHSEEK_RETURN_IF_ERROR(
       index->ForEachDistanceRow(parts, [&](const IndexShards::Row& row) -> absl::Status {
-        const std::size_t i = state.model_ids.size();
-        if (row.distances.front().size() != n || i >= n) {
+        if (row.distances.front().size() != n || i >= n ||
+            row.model->model_id() != state.model_ids[i]) {
           return absl::AbortedError("the collection changed during its build; build again");
         }
-        state.model_ids.push_back(row.model->model_id());
-        state.ordinals.push_back(row.model->ordinal());
-        state.labels.push_back(row.model->label());
-        if (state.graph.has_value()) {
-          FuseRows(row.distances, factors, absl::MakeSpan(fused));
-          state.graph->SetRow(static_cast<uint32_t>(i), fused);
-        }
+        FuseRows(row.distances, factors, absl::MakeSpan(fused));
+        state.graph->SetRow(static_cast<uint32_t>(i++), fused);
         return absl::OkStatus();
       }));
-  if (state.model_ids.size() != n) {
+  if (i != n) {
     return absl::AbortedError("the collection changed during its build; build again");
   }
   return state;

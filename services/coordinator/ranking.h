@@ -16,13 +16,15 @@
 // ingest"): the next node, fused with the build's scales, entering the graph
 // as a query would; a model removed since ranks nowhere.
 //
-// Cost of a build's ranking step: two passes over the parts' distances, the
-// sample rows then all rows (O(N^2) distances, in blocks of IndexShards'
-// kMatrixBatch rows), and a partial sort per row; above
-// RankingGraphOptions::exact_graph_models the second pass is the approximate
+// Cost of a build's ranking step: the sample rows' distances for the scales
+// (O(N x kScaleRows) up to kScaleColumns models, O(kScaleColumns x
+// kScaleRows) above: fusion.h), then, re-ranked, all rows (O(N^2)
+// distances, in blocks of IndexShards' kMatrixBatch rows) and a partial sort
+// per row; above RankingGraphOptions::exact_graph_models the approximate
 // graph's O(N x candidates) distances instead (docs/design.md "Approximate
-// neighbour graph"). The sample rows stay O(N x kScaleRows). Memory: the state is
-// about 12 bytes per neighbour (k1 + 1 per model) plus ids and labels.
+// neighbour graph"). A collection that is not re-ranked needs its models'
+// ids and the scales only. Memory: the state is about 12 bytes per
+// neighbour (k1 + 1 per model) plus ids and labels.
 #ifndef MESHSEEK_SERVICES_COORDINATOR_RANKING_H_
 #define MESHSEEK_SERVICES_COORDINATOR_RANKING_H_
 

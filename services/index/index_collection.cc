@@ -178,7 +178,7 @@ absl::Status IndexCollection::PrepareEngine(const std::string& model_id,
     // The first model fixes the vocabulary (or the only one replaces itself);
     // the epsilon stays.
     const KlDivergenceOptions options = kl != nullptr ? kl->options() : KlDivergenceOptions();
-    MESHSEEK_ASSIGN_OR_RETURN(KlInvertedIndex engine, KlInvertedIndex::Create(vocabulary, options));
+    MESHSEEK_ASSIGN_OR_RETURN(KlInvertedIndex engine, KlInvertedIndex::Create(vocabulary, options, storage_));
     engine_.emplace(std::move(engine));
   }
   docs_.clear();
@@ -222,7 +222,7 @@ absl::Status IndexCollection::SetEpsilon(double epsilon) {
   KlDivergenceOptions options = kl->options();
   options.epsilon = epsilon;
   MESHSEEK_ASSIGN_OR_RETURN(KlInvertedIndex rebuilt,
-                            KlInvertedIndex::Create(kl->vocabulary(), options));
+                            KlInvertedIndex::Create(kl->vocabulary(), options, storage_));
   absl::Status status;
   kl->ForEach([&](uint32_t doc, const SparseHistogram& histogram) {
     if (status.ok()) status = rebuilt.Upsert(doc, histogram);

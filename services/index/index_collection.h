@@ -49,6 +49,9 @@ struct EngineQuery;  // index_collection.cc
 
 class IndexCollection {
  public:
+  /// Where its histogram engine keeps what grows (kl_inverted_index.h).
+  explicit IndexCollection(KlIndexStorage storage = {}) : storage_(std::move(storage)) {}
+
   struct Model {
     std::string model_id;
     uint64_t ordinal = 0;
@@ -142,6 +145,7 @@ class IndexCollection {
   // collection is new or its only model replaces itself with another kind.
   absl::Status PrepareEngine(const std::string& model_id, const ModelSignature& signature);
 
+  KlIndexStorage storage_;
   absl::flat_hash_map<std::string, uint32_t> docs_;  // model id -> doc
   absl::flat_hash_map<uint32_t, Model> models_;      // doc -> model
   uint32_t next_doc_ = 0;

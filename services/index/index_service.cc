@@ -1,6 +1,7 @@
 #include "services/index/index_service.h"
 
 #include <algorithm>
+#include <filesystem>
 
 #include "absl/strings/str_cat.h"
 #include "common/base/parallel.h"
@@ -24,13 +25,23 @@ absl::StatusOr<ModelSignature> SignatureOf(const v1::SparseHistogram& histogram,
 
 absl::Status IndexServiceOptions::Validate() const {
   if (data_dir.empty()) return absl::InvalidArgumentError("index: --data_dir is required");
+  if (postings_max_models == 0) {
+    return absl::InvalidArgumentError("index: --postings_max_models must be at least 1");
+  }
   return absl::OkStatus();
+}
+
+IndexCollection& IndexService::CollectionNamed(const std::string& name) {
+  return collections_.try_emplace(name, storage_).first->second;
 }
 
 absl::StatusOr<std::unique_ptr<IndexService>> IndexService::Create(
     const IndexServiceOptions& options) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   MESHSEEK_ASSIGN_OR_RETURN(std::unique_ptr<IndexStore> store, IndexStore::Open(options.data_dir));
+  // Forward files are derived and unlinked; any left by name is stale.
+  std::error_code ignored;
+  std::filesystem::remove_all(options.data_dir + "/forward", ignored);
   std::unique_ptr<IndexService> service(new IndexService(options, std::move(store)));
   MESHSEEK_RETURN_IF_ERROR(service->Load());
   IndexService* index = service.get();
@@ -58,7 +69,7 @@ absl::Status IndexService::Load() {
         model.histogram(), model.has_global_descriptor(), model.global_descriptor(), what);
     absl::Status placed = signature.status();
     if (placed.ok()) {
-      placed = collections_[name].Place(model.model_id(), model.ordinal(), model.label(), *signature);
+      placed = CollectionNamed(name).Place(model.model_id(), model.ordinal(), model.label(), *signature);
     }
     if (placed.ok()) return placed;
     return absl::DataLossError(absl::StrCat("index: stored histogram of model '", model.model_id(),
@@ -97,7 +108,7 @@ absl::StatusOr<v1::AddModelResponse> IndexService::AddModel(const v1::AddModelRe
   }
   MESHSEEK_RETURN_IF_ERROR(store_->Upsert(request.collection(), model));
   absl::MutexLock lock(&mutex_);
-  IndexCollection& collection = collections_[request.collection()];
+  IndexCollection& collection = CollectionNamed(request.collection());
   MESHSEEK_RETURN_IF_ERROR(
       collection.Place(request.model_id(), request.ordinal(), request.label(), signature));
   v1::AddModelResponse response;

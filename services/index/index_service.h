@@ -8,8 +8,11 @@
 // collection's kind.
 //
 // Every add and remove is written to SQLite (WAL, index_store.h) before it is
-// answered, and the whole index is loaded into memory at start
+// answered, and the whole index is loaded from it at start
 // (index_collection.h), so a kill -9 and restart lose no acknowledged model.
+// The histograms' forward indexes live in unlinked files under
+// <data_dir>/forward (kl_inverted_index.h, "Storage"), rebuilt by that load:
+// derived data that a crash cannot leave half-written.
 // Adds are upserts by (collection, model id): a retry never duplicates.
 //
 // One server may be one shard of a collection: the coordinator places each
@@ -39,6 +42,12 @@ struct IndexServiceOptions {
   /// Threads for one search and for a batch of Distances (<= 0: all cores).
   /// Results do not depend on it.
   int num_threads = 0;
+  /// A collection's postings are freed past this many models on this
+  /// server, and its full scans read the forward index (kl_inverted_index.h,
+  /// "Storage"): at 20,000 BF-DSIFT models the postings take about 0.8 GB,
+  /// and every exact graph (up to the coordinator's 5,000 models) and every
+  /// development set is far below. At least 1.
+  std::size_t postings_max_models = 20000;
 
   absl::Status Validate() const;
 };
@@ -126,7 +135,12 @@ class IndexService final : public v1::Index::Service {
 
  private:
   IndexService(const IndexServiceOptions& options, std::unique_ptr<IndexStore> store)
-      : options_(options), store_(std::move(store)) {}
+      : options_(options), store_(std::move(store)) {
+    storage_.forward_dir = options.data_dir + "/forward";
+    storage_.postings_max_models = options.postings_max_models;
+  }
+  // The collection `name`, made empty (with storage_) if new.
+  IndexCollection& CollectionNamed(const std::string& name) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   absl::Status Load();
   // Makes collection `name` rank with `epsilon` (0: the default), rebuilding
   // its inverted file under the writer lock when it uses another.
@@ -137,6 +151,7 @@ class IndexService final : public v1::Index::Service {
       ABSL_SHARED_LOCKS_REQUIRED(mutex_);
 
   const IndexServiceOptions options_;
+  KlIndexStorage storage_;
   // Serialises writers: the store's write and the in-memory update of one
   // add happen in the same order for every writer.
   absl::Mutex write_mutex_;
