@@ -398,8 +398,9 @@ bool EvalInProcess() { return absl::GetFlag(FLAGS_server) == "in-process"; }
 
 absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
     const std::vector<ManifestEntry>& models,
-    const CollectionOptions& options,
+    CollectionOptions* flags,
     const std::string& manifest_path) {
+  const CollectionOptions& options = *flags;
   const auto start = absl::Now();
   MESHSEEK_ASSIGN_OR_RETURN(auto session, Session::Open());
   v1::Coordinator::Stub* stub = session->stub();
@@ -449,14 +450,20 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
   const std::size_t n = models.size();
   evaluation.models = models;
   evaluation.distances.assign(n * n, 0.0f);
-  evaluation.methods.resize(options.methods.size());
-  for (std::size_t m = 0; m < options.methods.size(); ++m) {
+  // The collection's own methods (an existing one evaluated without flags
+  // keeps those it was made with, whatever the default).
+  MESHSEEK_ASSIGN_OR_RETURN(CollectionOptions stored,
+                            rpc::CollectionOptionsFromParams(info.params()));
+  stored.SetRunOptions(options.num_threads(), options.show_progress());
+  *flags = stored;
+  evaluation.methods.resize(stored.methods.size());
+  for (std::size_t m = 0; m < stored.methods.size(); ++m) {
     MethodEvaluation& method = evaluation.methods[m];
-    method.method = options.methods[m].extractor.method;
+    method.method = stored.methods[m].extractor.method;
     method.features_per_model.assign(n, 0);
     method.codebook_size = FeatureMethodInfoOf(method.method).kind == DescriptorKind::kGlobal
                                ? 0
-                               : options.methods[m].kmeans.num_centroids;
+                               : stored.methods[m].kmeans.num_centroids;
   }
   std::vector<std::string> row_ids;
   std::size_t rows = 0;
@@ -512,7 +519,7 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
   std::vector<std::string> labels;
   for (const ManifestEntry& m : models) labels.push_back(m.label);
   MESHSEEK_ASSIGN_OR_RETURN(evaluation.metrics,
-                            EvaluateRetrieval(labels, evaluation.distances, options.num_threads()));
+                            EvaluateRetrieval(labels, evaluation.distances, stored.num_threads()));
   evaluation.timings.rank_seconds = absl::ToDoubleSeconds(absl::Now() - rank_start);
   evaluation.timings.total_seconds = absl::ToDoubleSeconds(absl::Now() - start);
   std::fprintf(stderr, "eval: collection '%s'\n", collection.c_str());

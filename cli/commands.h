@@ -23,11 +23,13 @@ absl::Status RunServe();
 absl::Status RunWeb();
 
 // eval's two paths: --server=in-process runs the pipeline in this process;
-// otherwise the models go through the coordinator (client_commands.cc).
+// otherwise the models go through the coordinator (client_commands.cc), into
+// the collection the flags make, or the existing one named by --collection,
+// whose own options then replace `options` (run options kept).
 bool EvalInProcess();
 absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(
     const std::vector<ManifestEntry>& models,
-    const CollectionOptions& options,
+    CollectionOptions* options,
     const std::string& manifest_path);
 absl::Status RunSynth();
 absl::Status RunInspect(const std::string& model_path);

@@ -27,7 +27,7 @@ absl::Status RunEval() {
   if (out_dir.empty()) return absl::InvalidArgumentError("eval needs --out DIR");
 
   MESHSEEK_ASSIGN_OR_RETURN(const OutputFormat format, OutputFormatFromFlags());
-  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromFlags());
+  MESHSEEK_ASSIGN_OR_RETURN(CollectionOptions options, CollectionOptionsFromFlags());
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<ManifestEntry> models, ReadManifest(manifest_path));
   std::fprintf(stderr,
                "meshseek eval: %zu models from %s, method %s, %d threads\n",
@@ -38,7 +38,7 @@ absl::Status RunEval() {
   MESHSEEK_ASSIGN_OR_RETURN(const CollectionEvaluation evaluation,
                             EvalInProcess()
                                 ? EvaluateCollection(models, options)
-                                : EvaluateThroughServices(models, options, manifest_path));
+                                : EvaluateThroughServices(models, &options, manifest_path));
   MESHSEEK_RETURN_IF_ERROR(WriteEvaluation(evaluation, options, out_dir));
   if (format == OutputFormat::kJson) {
     std::printf("%s\n", EvaluationMetricsJson(evaluation, options).Dump().c_str());

@@ -71,11 +71,14 @@ std::vector<char*> ParseCommandLineWithParams(int argc, char** argv, absl::strin
   return absl::ParseCommandLine(rest_argc, rest.data());
 }
 
-absl::StatusOr<CollectionOptions> CollectionOptionsFromFlags() {
+namespace {
+
+// The options of `values` with the run flags; errors name the flags.
+absl::StatusOr<CollectionOptions> OptionsOf(const ParamValues& values) {
   if (!MissingValue().empty()) {
     return absl::InvalidArgumentError(absl::StrCat("--", MissingValue(), " needs a value"));
   }
-  absl::StatusOr<CollectionOptions> options = CollectionOptionsFromValues(GivenValues());
+  absl::StatusOr<CollectionOptions> options = CollectionOptionsFromValues(values);
   if (!options.ok()) {
     return absl::InvalidArgumentError(absl::StrCat("flags: ", options.status().message()));
   }
@@ -83,8 +86,17 @@ absl::StatusOr<CollectionOptions> CollectionOptionsFromFlags() {
   return options;
 }
 
+}  // namespace
+
+absl::StatusOr<CollectionOptions> CollectionOptionsFromFlags() { return OptionsOf(GivenValues()); }
+
 absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags() {
-  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromFlags());
+  // A command of one method that names none works with kDefaultSingleMethod.
+  ParamValues values = GivenValues();
+  if (std::none_of(values.begin(), values.end(), [](const auto& v) { return v.first == "method"; })) {
+    values.insert(values.begin(), {"method", kDefaultSingleMethod});
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, OptionsOf(values));
   if (options.fused() || options.rerank.enabled()) {
     return absl::InvalidArgumentError(
         absl::StrCat("flags: this command works with one method, got --method ",

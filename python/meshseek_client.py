@@ -105,13 +105,15 @@ class Client:
     def __exit__(self, *exc):
         self.close()
 
-    def create_collection(self, name, method="dld", timeout=30.0, **params):
+    def create_collection(self, name, method=None, timeout=30.0, **params):
         """Creates collection `name` (or returns it when it exists with the same parameters).
 
-        params: pipeline parameters by name (`meshseek --help` lists them), e.g.
-        points=256, vocabulary=64; the method's defaults for the others.
+        method: "dld", "bfdsift+rld+lsf+lfd", ...; None: the service's default, the
+        four methods fused and re-ranked. params: pipeline parameters by name
+        (`meshseek --help` lists them), e.g. points=256, vocabulary=64; the
+        method's defaults for the others.
         """
-        values = [types_pb2.ParamValue(name="method", value=method)]
+        values = [] if method is None else [types_pb2.ParamValue(name="method", value=method)]
         values += [types_pb2.ParamValue(name=k, value=str(v)) for k, v in params.items()]
         params = types_pb2.PipelineParams(values=values)
         return self.stub.CreateCollection(pb.CreateCollectionRequest(name=name, params=params),

@@ -63,7 +63,7 @@ docker image ls "$MESHSEEK_IMAGE" --format 'deploy_test: image {{.Repository}}:{
 
 step "reference: the synthetic benchmark through the embedded stack"
 "$BIN" synth --out "$T/syn" >/dev/null
-"$BIN" eval --progress=false --manifest "$T/syn/manifest.csv" --out "$T/embedded" \
+"$BIN" eval --method dld --progress=false --manifest "$T/syn/manifest.csv" --out "$T/embedded" \
   --data_dir "$T/embedded-data" 2>/dev/null | grep -E "micro|macro"
 
 wait_serving() {
@@ -104,7 +104,7 @@ declare -A before
 for s in $SERVICES; do before[$s]=$(calls_served "$s"); done
 
 step "eval through the published coordinator; scale extract 1 -> 3 and kill one mid-ingest"
-"$BIN" eval --progress=false --server "localhost:$MESHSEEK_PORT" --collection synthetic \
+"$BIN" eval --method dld --progress=false --server "localhost:$MESHSEEK_PORT" --collection synthetic \
   --manifest "$T/syn/manifest.csv" --out "$T/cluster" > "$T/cluster.log" 2>&1 &
 EVAL=$!
 sleep 3

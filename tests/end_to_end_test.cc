@@ -181,8 +181,8 @@ TEST_F(EndToEndTest, CliNamesTheModelAndLineOfABadMeshAndFailsCleanly) {
   std::ofstream(dir + "/manifest.csv") << "id,class,path\na,x,ok.off\nb,x,broken.off\nc,x,ok.off\n";
   std::string output;
   const int code =
-      RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --progress=false --manifest " + dir +
-                     "/manifest.csv --out " + dir + "/out",
+      RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --method dld --progress=false --manifest " +
+                     dir + "/manifest.csv --out " + dir + "/out",
                  &output);
   EXPECT_NE(code, 0);
   EXPECT_THAT(output, HasSubstr("model 'b' (manifest line 3)"));
@@ -249,7 +249,7 @@ TEST_F(EndToEndTest, CliRejectsBadFlagsWithAClearMessage) {
                        &output),
             2);
   EXPECT_THAT(output, HasSubstr("parameter method: 'sift3d' is not one of dld, rld, ld"));
-  EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest " + *dir_ +
+  EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --method dld --manifest " + *dir_ +
                            "/bench/manifest.csv --out /tmp/x --scale -1",
                        &output),
             2);
@@ -257,7 +257,8 @@ TEST_F(EndToEndTest, CliRejectsBadFlagsWithAClearMessage) {
   EXPECT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " frobnicate", &output), 2);
   EXPECT_THAT(output, HasSubstr("unknown command 'frobnicate'"));
   EXPECT_EQ(
-      RunCommand(std::string(MESHSEEK_CLI_PATH) + " eval --manifest /nonexistent.csv --out /tmp/x",
+      RunCommand(std::string(MESHSEEK_CLI_PATH) +
+                     " eval --method dld --manifest /nonexistent.csv --out /tmp/x",
                  &output),
       1);
   EXPECT_THAT(output, HasSubstr("/nonexistent.csv"));

@@ -25,6 +25,7 @@
 #include "common/eval/manifest.h"
 #include "common/geometry/mesh_io.h"
 #include "common/pipeline/collection_evaluation.h"
+#include "common/pipeline/pipeline_params.h"
 #include "common/rpc/client.h"
 #include "common/rpc/convert.h"
 #include "common/rpc/free_port.h"
@@ -474,6 +475,25 @@ TEST_F(ServicesTest, BadInputGetsTheRightCodeANamedProblemAndServersKeepServing)
   ASSERT_TRUE(stack.WaitServing());
   auto stub = stack.Coordinator();
   ASSERT_TRUE(CreateCollection(stub.get(), "good").ok());
+  // Parameters that name no method: the default fusion, re-ranked (stored
+  // with every value, the method first); legacy fields alone keep dld.
+  {
+    ASSERT_TRUE(CreateCollection(stub.get(), "default", v1::PipelineParams()).ok());
+    v1::PipelineParams legacy;
+    legacy.set_vocabulary(24);
+    ASSERT_TRUE(CreateCollection(stub.get(), "legacy", legacy).ok());
+    for (const auto& [name, method] : std::vector<std::pair<std::string, std::string>>{
+             {"default", kDefaultCollectionMethods}, {"legacy", "dld"}}) {
+      grpc::ClientContext context;
+      v1::GetCollectionRequest request;
+      request.set_name(name);
+      v1::Collection response;
+      ASSERT_TRUE(stub->GetCollection(&context, request, &response).ok());
+      ASSERT_GT(response.params().values_size(), 0);
+      EXPECT_EQ(response.params().values(0).name(), "method");
+      EXPECT_EQ(response.params().values(0).value(), method) << name;
+    }
+  }
 
   // Unknown collection.
   {

@@ -92,7 +92,7 @@ absl::StatusOr<std::vector<FeatureMethod>> ParseMethods(absl::string_view method
 
 absl::StatusOr<CollectionOptions> CollectionOptionsFromValues(const ParamValues& values) {
   // The methods decide every other parameter's default and meaning.
-  std::string method_list = FeatureMethodName(FeatureMethod::kDldSift);
+  std::string method_list = kDefaultCollectionMethods;
   for (const auto& [name, value] : values) {
     if (name == "method") method_list = value;
   }
@@ -184,7 +184,11 @@ ParamValues CollectionValuesOf(const CollectionOptions& options) {
 }
 
 absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromValues(const ParamValues& values) {
-  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromValues(values));
+  ParamValues named = values;
+  const bool method_named = std::any_of(values.begin(), values.end(),
+                                        [](const auto& v) { return v.first == "method"; });
+  if (!method_named) named.insert(named.begin(), {"method", kDefaultSingleMethod});
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromValues(named));
   if (options.fused() || options.rerank.enabled()) {
     return absl::InvalidArgumentError(
         absl::StrCat("parameters of one method were expected, got '",

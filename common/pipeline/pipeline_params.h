@@ -91,8 +91,18 @@ bool IsPipelineParamName(absl::string_view name);
 /// (name, value) pairs in the order given.
 using ParamValues = std::vector<std::pair<std::string, std::string>>;
 
-/// Options from named values: the methods first (default dld), their
-/// defaults, then every other value in order (a later value of the same name
+/// The methods of a collection or an evaluation that names none: the four
+/// fused and re-ranked, the best configuration measured (first tier 94.1 on
+/// McGill and 61.9 on PSB train, against 75.0 and 37.6 for dld; its costs
+/// beside each method's in docs/results.md, "What each method costs").
+inline constexpr char kDefaultCollectionMethods[] = "bfdsift+rld+lsf+lfd";
+/// The method of what works with one method (a service's extraction, inspect,
+/// synth's seed) and names none, and of a stored collection that predates
+/// named values: the fastest local method.
+inline constexpr char kDefaultSingleMethod[] = "dld";
+
+/// Options from named values: the methods first (default
+/// kDefaultCollectionMethods), their defaults, then every other value in order (a later value of the same name
 /// wins). InvalidArgument naming the parameter for an unknown name, a value
 /// that does not parse as its type or lies outside its range, a parameter
 /// that applies to no method named (or a qualified one to a method not
@@ -107,9 +117,9 @@ absl::StatusOr<CollectionOptions> CollectionOptionsFromValues(const ParamValues&
 ParamValues CollectionValuesOf(const CollectionOptions& options);
 
 /// One method's options from values that name one method (its canonical
-/// values, or a collection's without fusion or re-ranking): what the extract
-/// and codebook services read. InvalidArgument as above, or for several
-/// methods or enabled re-ranking.
+/// values, or a collection's without fusion or re-ranking; none named:
+/// kDefaultSingleMethod): what the extract and codebook services read.
+/// InvalidArgument as above, or for several methods or enabled re-ranking.
 absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromValues(const ParamValues& values);
 /// The canonical values of `options` as a collection of its own (no fusion,
 /// no re-ranking): what the coordinator gives a fused collection's member

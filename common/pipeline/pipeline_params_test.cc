@@ -95,6 +95,18 @@ TEST(PipelineParamsTest, SetsTheSelectedMethodsField) {
   EXPECT_EQ(dld->extractor.dld.num_points, 64);
 }
 
+TEST(PipelineParamsTest, NoMethodIsTheFusionForACollectionAndDldForOneMethod) {
+  const auto collection = CollectionOptionsFromValues({});
+  ASSERT_TRUE(collection.ok()) << collection.status();
+  EXPECT_EQ(collection->MethodName(), kDefaultCollectionMethods);
+  EXPECT_EQ(collection->MethodName(), "bfdsift+rld+lsf+lfd");
+  EXPECT_TRUE(collection->rerank.enabled());
+  const auto one = PipelineOptionsFromValues({{"points", "64"}});
+  ASSERT_TRUE(one.ok()) << one.status();
+  EXPECT_EQ(one->extractor.method, FeatureMethod::kDldSift);
+  EXPECT_EQ(one->extractor.dld.num_points, 64);
+}
+
 TEST(PipelineParamsTest, BadValuesAreRefusedNamingTheParameter) {
   auto error = [](const ParamValues& values) {
     const auto options = PipelineOptionsFromValues(values);

@@ -112,7 +112,8 @@ std::string PipelineParamsUsage() {
     if (distinct.size() == 1) defaults = {*distinct.begin()};
     absl::StrAppend(&usage, "  --", spec.name, "  ", spec.TypeDescription(), "; ", spec.doc, "\n");
     if (spec.name == "method") {
-      absl::StrAppend(&usage, "      default: ", FeatureMethodName(FeatureMethod::kDldSift), "\n");
+      absl::StrAppend(&usage, "      default: ", kDefaultCollectionMethods,
+                      " (fused, re-ranked); a command of one method: ", kDefaultSingleMethod, "\n");
     } else {
       absl::StrAppend(
           &usage, "      ", spec.AppliesToText(), "; default: ", absl::StrJoin(defaults, ", "), "\n");

@@ -7,6 +7,7 @@
 #include "absl/time/clock.h"
 #include "common/base/logging.h"
 #include "common/base/status_macros.h"
+#include "common/pipeline/pipeline_params.h"
 #include "common/render/thumbnail.h"
 #include "common/rpc/convert.h"
 
@@ -122,11 +123,36 @@ absl::StatusOr<v1::Collection> CoordinatorService::DescribeCollection(const std:
   return collection;
 }
 
+namespace {
+
+// A new collection whose parameters name no method, by value or by a legacy
+// field, is the default fusion (kDefaultCollectionMethods); a stored one
+// never reaches this (it is stored with every value, its method first), and
+// a request with legacy fields only keeps their meaning (dld).
+v1::PipelineParams WithDefaultMethods(const v1::PipelineParams& params) {
+  for (const v1::ParamValue& v : params.values()) {
+    if (v.name() == "method") return params;
+  }
+  v1::PipelineParams legacy = params;
+  legacy.clear_values();
+  if (legacy.ByteSizeLong() != 0) return params;
+  v1::PipelineParams named = params;
+  v1::ParamValue* method = named.add_values();
+  method->set_name("method");
+  method->set_value(kDefaultCollectionMethods);
+  // The method first: every other value reads in its light.
+  for (int i = named.values_size() - 1; i > 0; --i) named.mutable_values()->SwapElements(i, i - 1);
+  return named;
+}
+
+}  // namespace
+
 absl::StatusOr<v1::Collection> CoordinatorService::CreateCollection(
     const v1::CreateCollectionRequest& request, const rpc::CallContext&) {
   MESHSEEK_RETURN_IF_ERROR(CheckName("collection name", request.name(), 128, true));
   const std::string where = absl::StrCat("collection '", request.name(), "'");
-  absl::StatusOr<CollectionOptions> valid = rpc::CollectionOptionsFromParams(request.params());
+  absl::StatusOr<CollectionOptions> valid =
+      rpc::CollectionOptionsFromParams(WithDefaultMethods(request.params()));
   if (!valid.ok()) return Prefixed(valid.status(), where + ": ");
   for (const RetrievalPipelineOptions& method : valid->methods) {
     if (method.weighting.idf) {
