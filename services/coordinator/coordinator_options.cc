@@ -41,6 +41,11 @@ absl::Status CoordinatorOptions::Validate() const {
         "coordinator: retry_backoff must be positive and at most max_retry_backoff, got ",
         absl::FormatDuration(retry_backoff), " and ", absl::FormatDuration(max_retry_backoff)));
   }
+  if (ranking_graph.query_candidates < 1 || ranking_graph.query_candidates > kMaxFusedCandidates) {
+    return absl::InvalidArgumentError(absl::StrCat("coordinator: query_candidates must be in [1, ",
+                                                   kMaxFusedCandidates, "], got ",
+                                                   ranking_graph.query_candidates));
+  }
   if (ranking_graph.graph_candidates < 1 || ranking_graph.graph_candidates > kMaxFusedCandidates ||
       ranking_graph.threads < 1) {
     return absl::InvalidArgumentError(absl::StrCat(

@@ -31,6 +31,13 @@ struct RankingGraphOptions {
   /// [1, kMaxFusedCandidates]. Measured on the development sets:
   /// bench/results/fused_candidates.txt.
   uint32_t graph_candidates = 50;
+  /// Candidates per method of a fused query that names none, on a
+  /// collection past exact_graph_models (a whole row of a large collection
+  /// is a scan of every model by every method). 100 kept recall@10 against
+  /// the exact fused ranking at 0.9992 (McGill) and 0.9924 (PSB train), 50
+  /// at 0.9980 and 0.9736 (bench/results/fused_candidates.txt). In [1,
+  /// kMaxFusedCandidates].
+  uint32_t query_candidates = 100;
   /// Models whose lists are computed at once (each mostly waits on the
   /// index), at least 1.
   int threads = 4;

@@ -132,12 +132,20 @@ absl::StatusOr<v1::QueryResponse> CoordinatorService::Query(const v1::QueryReque
     MESHSEEK_ASSIGN_OR_RETURN(const std::shared_ptr<LiveRanking> ranking, live_.RankingOf(plan));
     std::vector<const IndexSignature*> query;
     for (const IndexSignature& signature : signatures) query.push_back(&signature);
+    // A large collection is never scanned whole unless asked for candidates.
+    const RankingGraphOptions& graph = workers_.options().ranking_graph;
+    uint32_t candidates = request.candidates();
+    if (candidates == 0) {
+      absl::ReaderMutexLock lock(&ranking->mutex);
+      if (ranking->ranking.state.model_ids.size() > graph.exact_graph_models) {
+        candidates = graph.query_candidates;
+      }
+    }
     MESHSEEK_ASSIGN_OR_RETURN(
         const std::vector<std::vector<IndexShards::Scored>> distances,
-        request.candidates() > 0
-            ? CandidatePartDistances(workers_.index(), plan, query,
-                                     std::max(request.candidates(), request.top_k()))
-            : PartDistances(workers_.index(), plan, query));
+        candidates > 0 ? CandidatePartDistances(workers_.index(), plan, query,
+                                                std::max(candidates, request.top_k()))
+                       : PartDistances(workers_.index(), plan, query));
     absl::ReaderMutexLock lock(&ranking->mutex);
     MESHSEEK_ASSIGN_OR_RETURN(found, ranking->ranking.Query(distances, plan.options, request.top_k()));
   }

@@ -3,7 +3,7 @@
 // --data_dir, the four service targets, the work limits, --token_file (bearer
 // token of the public API), the TLS flags of the channels to the services
 // (--service_tls_*), the ranking graph (--exact_graph_models,
-// --graph_candidates), and the server flags (common/rpc/server_main.h).
+// --graph_candidates, --query_candidates), and the server flags (common/rpc/server_main.h).
 #include <algorithm>
 
 #include "absl/flags/flag.h"
@@ -47,6 +47,9 @@ ABSL_FLAG(int64_t, exact_graph_models,
           "candidates above");
 ABSL_FLAG(uint32_t, graph_candidates, kDefaults.ranking_graph.graph_candidates,
           "candidates per method of each model's list in an approximate neighbour graph");
+ABSL_FLAG(uint32_t, query_candidates, kDefaults.ranking_graph.query_candidates,
+          "candidates per method of a fused query that names none, on a collection past "
+          "--exact_graph_models");
 ABSL_FLAG(std::string, token_file, "",
           "file holding the bearer token every call but grpc.health.v1 must carry "
           "(UNAUTHENTICATED otherwise); needs --tls_cert/--tls_key");
@@ -80,6 +83,7 @@ int main(int argc, char** argv) {
   options.ranking_graph.exact_graph_models =
       static_cast<std::size_t>(std::max<int64_t>(0, absl::GetFlag(FLAGS_exact_graph_models)));
   options.ranking_graph.graph_candidates = absl::GetFlag(FLAGS_graph_candidates);
+  options.ranking_graph.query_candidates = absl::GetFlag(FLAGS_query_candidates);
   auto limits = meshseek::rpc::MeshLimitsFromFlags();
   if (!limits.ok()) return meshseek::rpc::ExitWithError("coordinator", limits.status());
   options.mesh_limits = *limits;
