@@ -108,22 +108,33 @@ absl::StatusOr<std::vector<v1::ScoredModel>> IndexShards::Search(const v1::Searc
   return merged;
 }
 
-absl::StatusOr<std::vector<v1::IndexedModel>> IndexShards::Export(
-    std::size_t s, const v1::ExportModelsRequest& request) {
-  std::vector<v1::IndexedModel> models;
-  const absl::Status status = rpc::RetryTransient(
+template <typename Message, typename Method, typename Request, typename Restart, typename Take>
+absl::Status IndexShards::ReadStream(std::size_t s,
+                                     Method method,
+                                     const Request& request,
+                                     Restart&& restart,
+                                     Take&& take) {
+  return rpc::RetryTransient(
       [&]() -> absl::Status {
-        models.clear();
+        restart();
         grpc::ClientContext context;
         rpc::SetDeadline(&context, call_deadline_);
-        auto reader = shards_[s]->ExportModels(&context, request);
-        v1::IndexedModel model;
-        while (reader->Read(&model)) models.push_back(std::move(model));
+        auto reader = (shards_[s].get()->*method)(&context, request);
+        Message message;
+        while (reader->Read(&message)) take(message);
         const grpc::Status done = reader->Finish();
         return absl::Status(static_cast<absl::StatusCode>(done.error_code()),
                             done.error_message());
       },
       retry_, stop_);
+}
+
+absl::StatusOr<std::vector<v1::IndexedModel>> IndexShards::Export(
+    std::size_t s, const v1::ExportModelsRequest& request) {
+  std::vector<v1::IndexedModel> models;
+  const absl::Status status = ReadStream<v1::IndexedModel>(
+      s, &v1::Index::Stub::ExportModels, request, [&] { models.clear(); },
+      [&](v1::IndexedModel& model) { models.push_back(std::move(model)); });
   if (status.code() == absl::StatusCode::kNotFound) return std::vector<v1::IndexedModel>();
   if (!status.ok()) {
     return absl::Status(status.code(), absl::StrCat("index shard ", s, ": ", status.message()));
@@ -388,21 +399,11 @@ absl::StatusOr<std::vector<std::vector<IndexShards::Scored>>> IndexShards::Neigh
     request.set_candidates(candidates);
     for (v1::QueryModel& q : queries[s]) *request.add_queries() = std::move(q);
     std::vector<std::vector<Scored>> lists;
-    const absl::Status status = rpc::RetryTransient(
-        [&]() -> absl::Status {
-          lists.clear();
-          grpc::ClientContext context;
-          rpc::SetDeadline(&context, call_deadline_);
-          auto reader = shards_[s]->Neighbors(&context, request);
-          v1::NeighborLists batch;
-          while (reader->Read(&batch)) {
-            for (const v1::NeighborList& list : batch.lists()) AppendScored(list, &lists.emplace_back());
-          }
-          const grpc::Status done = reader->Finish();
-          return absl::Status(static_cast<absl::StatusCode>(done.error_code()),
-                              done.error_message());
-        },
-        retry_, stop_);
+    const absl::Status status = ReadStream<v1::NeighborLists>(
+        s, &v1::Index::Stub::Neighbors, request, [&] { lists.clear(); },
+        [&](v1::NeighborLists& batch) {
+          for (const v1::NeighborList& list : batch.lists()) AppendScored(list, &lists.emplace_back());
+        });
     if (status.code() == absl::StatusCode::kNotFound && shards_.size() > 1) continue;
     if (!status.ok()) {
       return absl::Status(status.code(), absl::StrCat("index shard ", s, ": ", status.message()));

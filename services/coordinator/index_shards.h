@@ -136,6 +136,12 @@ class IndexShards {
   // them, whole (from their shards) where it does not.
   absl::StatusOr<std::vector<std::vector<v1::QueryModel>>> QueriesPerShard(
       const Part& part, const std::vector<std::string>& model_ids);
+  // Every message of a server stream of shard s, retried from the start on
+  // a transient failure (`restart` drops what a failed try delivered, `take`
+  // gets each message).
+  template <typename Message, typename Method, typename Request, typename Restart, typename Take>
+  absl::Status ReadStream(std::size_t s, Method method, const Request& request, Restart&& restart,
+                          Take&& take);
   // Calls `method` on every shard at once; shard s's answer, or nullopt when
   // it does not hold the collection (NotFound). NotFound from every shard is
   // the result; any other error names its shard.

@@ -119,28 +119,22 @@ TEST_F(IndexShardsTest, NeighboursOfTwoShardsAreThoseOfOne) {
 }
 
 TEST_F(IndexShardsTest, DistanceRowsOfTwoShardsAreThoseOfOne) {
-  std::vector<std::vector<float>> one, two;
   const std::vector<std::size_t> rows = {0, 5, kModels - 1};
-  ASSERT_TRUE(single_
-                  ->ForEachDistanceRow({part_},
-                                       [&](const IndexShards::Row& row) {
-                                         one.emplace_back(row.distances[0].begin(),
-                                                          row.distances[0].end());
-                                         return absl::OkStatus();
-                                       },
-                                       &rows)
-                  .ok());
-  ASSERT_TRUE(split_
-                  ->ForEachDistanceRow({part_},
-                                       [&](const IndexShards::Row& row) {
-                                         two.emplace_back(row.distances[0].begin(),
-                                                          row.distances[0].end());
-                                         return absl::OkStatus();
-                                       },
-                                       &rows)
-                  .ok());
+  const auto rows_of = [&](IndexShards* index) {
+    std::vector<std::vector<float>> out;
+    const absl::Status status = index->ForEachDistanceRow(
+        {part_},
+        [&](const IndexShards::Row& row) {
+          out.emplace_back(row.distances[0].begin(), row.distances[0].end());
+          return absl::OkStatus();
+        },
+        &rows);
+    EXPECT_TRUE(status.ok()) << status;
+    return out;
+  };
+  const std::vector<std::vector<float>> one = rows_of(single_.get());
   ASSERT_EQ(one.size(), rows.size());
-  EXPECT_EQ(one, two);
+  EXPECT_EQ(one, rows_of(split_.get()));
   // The rows without signatures: ids, ordinals and labels alone.
   const auto bare = split_->ExportParts({part_}, /*signatures=*/false);
   ASSERT_TRUE(bare.ok()) << bare.status();
