@@ -28,6 +28,7 @@ if [ "${1:-}" != "--build-only" ]; then
     libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
     libfaiss-dev libopenblas-dev                     # HNSW candidates of the index (Faiss on OpenBLAS)
     clang llvm libclang-rt-14-dev                    # libFuzzer harnesses (tests/fuzz; the runtime and sanitizer headers are only recommended by clang), llvm-symbolizer
+    libomp-14-dev                                    # ... OpenMP for clang, which Faiss needs to link
   )
 fi
 
