@@ -28,7 +28,7 @@
 #include "absl/flags/parse.h"
 #include "absl/strings/str_cat.h"
 #include "bench/bench_models.h"
-#include "cli/pipeline_flags.h"
+#include "common/flags/pipeline_flags.h"
 #include "common/base/hash.h"
 #include "common/features/local_feature_extractor.h"
 #include "common/geometry/mesh_io.h"
@@ -166,8 +166,9 @@ BENCHMARK(BM_ExtractRldSamples)
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  meshseek::cli::ParseCommandLineWithParams(argc, argv, "");
-  auto options = meshseek::cli::PipelineOptionsFromFlags();
+  const meshseek::flags::CommandLine line =
+      meshseek::flags::ParseCommandLineWithParams(argc, argv, "");
+  auto options = meshseek::flags::PipelineOptionsFromFlags(line.params);
   if (!options.ok()) {
     std::cerr << options.status() << "\n";
     return 2;

@@ -32,7 +32,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
-#include "cli/pipeline_flags.h"
+#include "common/flags/pipeline_flags.h"
 #include "common/eval/distance_matrix.h"
 #include "common/eval/manifest.h"
 #include "common/eval/retrieval_metrics.h"
@@ -105,9 +105,9 @@ std::vector<float> Restricted(const std::vector<float>& fused,
   return row;
 }
 
-int Run() {
+int Run(const flags::ParamFlags& params) {
   absl::StatusOr<std::vector<ManifestEntry>> models = ReadManifest(absl::GetFlag(FLAGS_manifest));
-  absl::StatusOr<CollectionOptions> options = cli::CollectionOptionsFromFlags();
+  absl::StatusOr<CollectionOptions> options = flags::CollectionOptionsFromFlags(params);
   if (!models.ok() || !options.ok()) {
     std::fprintf(stderr, "%s %s\n", models.status().ToString().c_str(),
                  options.status().ToString().c_str());
@@ -235,7 +235,7 @@ int Run() {
 }  // namespace meshseek
 
 int main(int argc, char** argv) {
-  meshseek::cli::ParseCommandLineWithParams(argc, argv,
-                                            "fused_candidates --manifest F --eval DIR --method M");
-  return meshseek::Run();
+  const meshseek::flags::CommandLine line = meshseek::flags::ParseCommandLineWithParams(
+      argc, argv, "fused_candidates --manifest F --eval DIR --method M");
+  return meshseek::Run(line.params);
 }

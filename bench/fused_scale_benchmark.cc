@@ -37,11 +37,11 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "bench/synthetic_histograms.h"
-#include "cli/pipeline_flags.h"
+#include "common/flags/pipeline_flags.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
 #include "common/global/lfd.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 #include "common/rpc/free_port.h"
 #include "services/coordinator/fused_candidates.h"
 #include "services/coordinator/ranking.h"
@@ -107,15 +107,15 @@ IndexSignature Signature(std::mt19937_64& rng, const RetrievalPipelineOptions& m
     s.descriptor = d;
     return s;
   }
-  rpc::SparseHistogramToProto(
+  wire::SparseHistogramToProto(
       SyntheticHistogram(rng, static_cast<int>(method.kmeans.num_centroids),
                          FeaturesPerModel(method.extractor.method)),
       &s.histogram);
   return s;
 }
 
-int Run() {
-  absl::StatusOr<CollectionOptions> options = cli::CollectionOptionsFromFlags();
+int Run(const flags::ParamFlags& params) {
+  absl::StatusOr<CollectionOptions> options = flags::CollectionOptionsFromFlags(params);
   if (!options.ok() || !options->rescaled()) {
     std::fprintf(stderr, "--method must name a fused or re-ranked collection\n");
     return 2;
@@ -281,6 +281,7 @@ int Run() {
 int main(int argc, char** argv) {
   // A line at a time, so that a run cut off by its time limit keeps what it measured.
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  meshseek::cli::ParseCommandLineWithParams(argc, argv, "fused_scale_benchmark --models N");
-  return meshseek::Run();
+  const meshseek::flags::CommandLine line =
+      meshseek::flags::ParseCommandLineWithParams(argc, argv, "fused_scale_benchmark --models N");
+  return meshseek::Run(line.params);
 }

@@ -38,7 +38,7 @@
 #include "bench/synthetic_histograms.h"
 #include "common/rpc/client.h"
 #include "common/rpc/free_port.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "meshseek/v1/index.grpc.pb.h"
 
@@ -129,7 +129,7 @@ class IndexProcess {
 // A synthetic histogram (see the file comment), normalised counts.
 void MakeHistogram(std::mt19937_64& rng, int vocabulary, int descriptors,
                    v1::SparseHistogram* out) {
-  rpc::SparseHistogramToProto(SyntheticHistogram(rng, vocabulary, descriptors), out);
+  wire::SparseHistogramToProto(SyntheticHistogram(rng, vocabulary, descriptors), out);
 }
 
 double Percentile(std::vector<double> values, double p) {

@@ -27,27 +27,22 @@
 #include <thread>
 #include <vector>
 
-#include "absl/flags/declare.h"
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
 #include "absl/strings/str_cat.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/clock.h"
-#include "cli/embedded_stack.h"
-#include "cli/pipeline_flags.h"
+#include "services/embedded/embedded_stack.h"
+#include "common/flags/pipeline_flags.h"
 #include "common/base/status_macros.h"
 #include "common/eval/manifest.h"
 #include "common/geometry/mesh_io.h"
 #include "common/rpc/client.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 #include "common/rpc/status.h"
 #include "common/synth/synthetic_benchmark.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"
-
-// Defined with the pipeline flags (cli/pipeline_flags.cc): extraction slots
-// and coordinator in-flight models of the embedded stack.
-ABSL_DECLARE_FLAG(int, threads);
 
 ABSL_FLAG(int, query_clients, 64, "concurrent Query clients");
 ABSL_FLAG(int, ingest_clients, 4, "concurrent Ingest clients (one model per stream)");
@@ -116,7 +111,7 @@ absl::StatusOr<std::vector<Model>> LoadModels(const std::string& bench_dir) {
     Model m;
     m.entry = e;
     MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh, ReadMesh(e.path));
-    rpc::MeshToProto(mesh, m.arrays.mutable_mesh());
+    wire::MeshToProto(mesh, m.arrays.mutable_mesh());
     std::ifstream in(e.path, std::ios::binary);
     std::ostringstream bytes;
     bytes << in.rdbuf();
@@ -154,12 +149,14 @@ grpc::Status IngestOne(v1::Coordinator::Stub* stub, const std::string& collectio
   return status;
 }
 
-absl::Status CreateCollection(v1::Coordinator::Stub* stub, const std::string& name) {
+absl::Status CreateCollection(v1::Coordinator::Stub* stub,
+                              const std::string& name,
+                              const flags::ParamFlags& params) {
   grpc::ClientContext context;
   rpc::SetDeadline(&context, absl::Minutes(1));
   v1::CreateCollectionRequest request;
   request.set_name(name);
-  MESHSEEK_ASSIGN_OR_RETURN(*request.mutable_params(), cli::CollectionParamsFromFlags());
+  MESHSEEK_ASSIGN_OR_RETURN(*request.mutable_params(), flags::CollectionParamsFromFlags(params));
   v1::Collection response;
   return rpc::FromGrpcStatus(stub->CreateCollection(&context, request, &response));
 }
@@ -180,7 +177,7 @@ absl::Status WaitFor(v1::Coordinator::Stub* stub, const std::string& job_id) {
   }
 }
 
-absl::Status Run() {
+absl::Status Run(const flags::ParamFlags& params) {
   std::string data_dir = absl::GetFlag(FLAGS_data_dir);
   const bool temporary = data_dir.empty();
   if (temporary) {
@@ -192,14 +189,14 @@ absl::Status Run() {
   MESHSEEK_RETURN_IF_ERROR(GenerateSyntheticBenchmark(synth, data_dir + "/bench"));
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<Model> models, LoadModels(data_dir + "/bench"));
   MESHSEEK_ASSIGN_OR_RETURN(auto stack,
-                            cli::EmbeddedStack::Start(data_dir + "/stack", absl::GetFlag(FLAGS_threads)));
+                            EmbeddedStack::Start(data_dir + "/stack", params.threads));
   auto setup = Connect(stack->coordinator_address());
   const absl::Duration deadline = absl::GetFlag(FLAGS_call_deadline);
 
   // Set-up: the queried collection, ingested and built.
   absl::Time start = absl::Now();
-  MESHSEEK_RETURN_IF_ERROR(CreateCollection(setup.get(), "load"));
-  MESHSEEK_RETURN_IF_ERROR(CreateCollection(setup.get(), "load-ingest"));
+  MESHSEEK_RETURN_IF_ERROR(CreateCollection(setup.get(), "load", params));
+  MESHSEEK_RETURN_IF_ERROR(CreateCollection(setup.get(), "load-ingest", params));
   for (const Model& m : models) {
     MESHSEEK_RETURN_IF_ERROR(rpc::FromGrpcStatus(IngestOne(setup.get(), "load", m.entry.id, m, deadline)));
   }
@@ -283,10 +280,10 @@ absl::Status Run() {
 }  // namespace meshseek
 
 int main(int argc, char** argv) {
-  meshseek::cli::ParseCommandLineWithParams(
+  const meshseek::flags::CommandLine line = meshseek::flags::ParseCommandLineWithParams(
       argc, argv, "load generator: N concurrent Query and Ingest clients on the embedded stack");
   cv::setNumThreads(0);  // meshseek parallelises across calls itself, as the CLI does
-  const absl::Status status = meshseek::Run();
+  const absl::Status status = meshseek::Run(line.params);
   if (!status.ok()) {
     std::fprintf(stderr, "load_benchmark: %s\n", std::string(status.message()).c_str());
     return 1;

@@ -19,7 +19,7 @@
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
-#include "cli/pipeline_flags.h"
+#include "common/flags/pipeline_flags.h"
 #include "common/eval/retrieval_metrics.h"
 #include "common/pipeline/retrieval_pipeline.h"
 #include "common/search/kl_inverted_index.h"
@@ -76,9 +76,9 @@ void PrintMetrics(const char* name, const RetrievalMetrics& m) {
               m.macro.rp_excl);
 }
 
-int Run() {
+int Run(const flags::ParamFlags& params) {
   auto models = ReadManifest(absl::GetFlag(FLAGS_manifest));
-  auto parsed = cli::PipelineOptionsFromFlags();
+  auto parsed = flags::PipelineOptionsFromFlags(params);
   if (!models.ok() || !parsed.ok()) {
     std::fprintf(stderr, "%s %s\n", models.status().ToString().c_str(),
                  parsed.status().ToString().c_str());
@@ -221,7 +221,8 @@ int Run() {
 }  // namespace meshseek
 
 int main(int argc, char** argv) {
-  meshseek::cli::ParseCommandLineWithParams(argc, argv, "");
+  const meshseek::flags::CommandLine line =
+      meshseek::flags::ParseCommandLineWithParams(argc, argv, "");
   cv::setNumThreads(0);
-  return meshseek::Run();
+  return meshseek::Run(line.params);
 }

@@ -26,7 +26,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
-#include "cli/pipeline_flags.h"
+#include "common/flags/pipeline_flags.h"
 #include "common/eval/retrieval_metrics.h"
 #include "common/pipeline/retrieval_pipeline.h"
 
@@ -159,7 +159,8 @@ std::vector<float> DenseDistances(const std::string& kind, std::vector<std::vect
 }  // namespace
 
 int main(int argc, char** argv) {
-  meshseek::cli::ParseCommandLineWithParams(argc, argv, "");
+  const meshseek::flags::CommandLine line =
+      meshseek::flags::ParseCommandLineWithParams(argc, argv, "");
   cv::setNumThreads(0);
   using namespace meshseek;
   auto models = ReadManifest(absl::GetFlag(FLAGS_manifest));
@@ -167,7 +168,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", models.status().ToString().c_str());
     return 1;
   }
-  auto parsed = cli::PipelineOptionsFromFlags();
+  auto parsed = flags::PipelineOptionsFromFlags(line.params);
   if (!parsed.ok()) {
     std::fprintf(stderr, "%s\n", parsed.status().ToString().c_str());
     return 2;

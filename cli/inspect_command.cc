@@ -20,11 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "absl/flags/declare.h"
-#include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
 #include "cli/commands.h"
-#include "cli/pipeline_flags.h"
 #include "common/base/status_macros.h"
 #include "common/features/depth_image.h"
 #include "common/geometry/enclosing_sphere.h"
@@ -34,10 +31,7 @@
 #include "common/geometry/triangle_bvh.h"
 #include "common/global/lfd_cameras.h"
 #include "common/render/view_renderer.h"
-#include "common/rpc/mesh_limit_flags.h"
 
-ABSL_DECLARE_FLAG(std::string, out);
-ABSL_FLAG(int, montage_images, 48, "inspect: depth images in the montage");
 
 namespace meshseek::cli {
 namespace {
@@ -218,13 +212,13 @@ absl::Status WriteViews(const std::string& path,
 
 }  // namespace
 
-absl::Status RunInspect(const std::string& model_path) {
-  const std::string out_dir = absl::GetFlag(FLAGS_out);
+absl::Status RunInspect(const CliFlags& flags, const std::string& model_path) {
+  const std::string& out_dir = flags.out;
   if (out_dir.empty()) return absl::InvalidArgumentError("inspect needs --out DIR");
-  MESHSEEK_ASSIGN_OR_RETURN(const RetrievalPipelineOptions options, PipelineOptionsFromFlags());
+  MESHSEEK_ASSIGN_OR_RETURN(const RetrievalPipelineOptions options, flags::PipelineOptionsFromFlags(flags.params));
   MeshReadReport report;
-  MESHSEEK_ASSIGN_OR_RETURN(const MeshReadOptions limits, rpc::MeshLimitsFromFlags());
-  MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh, ReadMesh(model_path, &report, limits));
+  MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh,
+                            ReadMesh(model_path, &report, flags.client.mesh_limits));
   MESHSEEK_ASSIGN_OR_RETURN(const LocalFeatures features,
                             ExtractLocalFeatures(mesh, options.extractor));
   std::error_code ec;
@@ -248,7 +242,7 @@ absl::Status RunInspect(const std::string& model_path) {
                                         mesh,
                                         features,
                                         options.extractor.dld.depth_image,
-                                        absl::GetFlag(FLAGS_montage_images)));
+                                        flags.montage_images));
   std::map<int, int> per_level;
   for (const Keypoint& k : features.keypoints) per_level[k.level]++;
   std::printf("%s: %s\n%s: %zu local features",

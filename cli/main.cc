@@ -5,8 +5,9 @@
 //   meshseek synth --out DIR [--models_per_class N] [--seed S]
 //   meshseek inspect MODEL --method ld|rld|dld --out DIR
 //
-// Flags are parsed here and only here, turned into validated option structs,
-// and handed to the core (common/). See `meshseek --help`.
+// Flags are parsed here and only here, read once into CliFlags (cli_flags.h)
+// and handed to the command, which builds validated options for the core
+// (common/). See `meshseek --help`.
 #include <cstdio>
 #include <iostream>
 #include <opencv2/core.hpp>
@@ -18,7 +19,6 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "cli/commands.h"
-#include "cli/pipeline_flags.h"
 #include "common/base/logging.h"
 
 namespace {
@@ -49,7 +49,8 @@ Commands:
            meshseek build --collection C
   query  Rank a collection's models by similarity to a mesh:
            meshseek query MODEL --collection C --top_k 10
-  status Show a collection, or follow a job: meshseek status --collection C | --job ID
+  status List the collections, show one, or follow a job:
+           meshseek status [--collection C | --job ID]
   serve  Run the embedded stack until Ctrl-C: meshseek serve --port 50051
          [--tls_cert C --tls_key K [--tls_ca CA] [--token_file T]] [--metrics_port 9464]
   web    Serve the query page (pick a collection, drop a mesh, see the ranked
@@ -76,7 +77,10 @@ int Fail(const absl::Status& status) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<char*> args = meshseek::cli::ParseCommandLineWithParams(argc, argv, kUsage);
+  namespace cli = meshseek::cli;
+  const meshseek::flags::CommandLine line =
+      meshseek::flags::ParseCommandLineWithParams(argc, argv, kUsage);
+  const std::vector<char*>& args = line.positional;
   if (args.size() < 2) {
     std::fprintf(stderr, "%s\n", kUsage);
     return 2;
@@ -87,29 +91,32 @@ int main(int argc, char** argv) {
     return Fail(absl::InvalidArgumentError(
         absl::StrCat("unexpected argument '", args[positional], "' (options are --flags)")));
   }
+  const absl::StatusOr<cli::CliFlags> flags = cli::ReadCliFlags(line.params);
+  if (!flags.ok()) return Fail(flags.status());
+  const std::string model = args.size() < 3 ? "" : args[2];
   cv::setNumThreads(0);  // meshseek parallelises across models itself
   absl::Status status;
   if (command == "eval") {
-    status = meshseek::cli::RunEval();
+    status = cli::RunEval(*flags);
   } else if (command == "report") {
-    status = meshseek::cli::RunReport();
+    status = cli::RunReport(*flags);
   } else if (command == "synth") {
-    status = meshseek::cli::RunSynth();
+    status = cli::RunSynth(*flags);
   } else if (command == "inspect") {
-    status = args.size() < 3 ? absl::InvalidArgumentError("inspect needs a MODEL file")
-                             : meshseek::cli::RunInspect(args[2]);
+    status = model.empty() ? absl::InvalidArgumentError("inspect needs a MODEL file")
+                           : cli::RunInspect(*flags, model);
   } else if (command == "ingest") {
-    status = meshseek::cli::RunIngest();
+    status = cli::RunIngest(*flags);
   } else if (command == "build") {
-    status = meshseek::cli::RunBuild();
+    status = cli::RunBuild(*flags);
   } else if (command == "query") {
-    status = meshseek::cli::RunQuery(args.size() < 3 ? "" : args[2]);
+    status = cli::RunQuery(*flags, model);
   } else if (command == "status") {
-    status = meshseek::cli::RunStatus();
+    status = cli::RunStatus(*flags);
   } else if (command == "serve") {
-    status = meshseek::cli::RunServe();
+    status = cli::RunServe(*flags);
   } else if (command == "web") {
-    status = meshseek::cli::RunWeb();
+    status = cli::RunWeb(*flags);
   } else {
     status = absl::InvalidArgumentError(absl::StrCat(
         "unknown command '",

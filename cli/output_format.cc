@@ -1,19 +1,11 @@
 #include "cli/output_format.h"
 
-#include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
 #include "google/protobuf/util/json_util.h"
 
-ABSL_FLAG(std::string,
-          format,
-          "text",
-          "status, query, eval: 'text' for people, 'json' for programs (one JSON document on "
-          "stdout; the proto's field names)");
-
 namespace meshseek::cli {
 
-absl::StatusOr<OutputFormat> OutputFormatFromFlags() {
-  const std::string format = absl::GetFlag(FLAGS_format);
+absl::StatusOr<OutputFormat> OutputFormatFromName(absl::string_view format) {
   if (format == "text") return OutputFormat::kText;
   if (format == "json") return OutputFormat::kJson;
   return absl::InvalidArgumentError(

@@ -14,14 +14,15 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "google/protobuf/message.h"
 
 namespace meshseek::cli {
 
 enum class OutputFormat { kText, kJson };
 
-/// --format, validated: "text" or "json".
-absl::StatusOr<OutputFormat> OutputFormatFromFlags();
+/// The format named by --format: "text" or "json"; InvalidArgument otherwise.
+absl::StatusOr<OutputFormat> OutputFormatFromName(absl::string_view name);
 
 /// `message` in the canonical JSON mapping described above, on one line.
 std::string ProtoToJson(const google::protobuf::Message& message);

@@ -3,8 +3,6 @@
 #include <cstdio>
 #include <string>
 
-#include "absl/flags/declare.h"
-#include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
 #include "cli/commands.h"
 #include "common/base/file_io.h"
@@ -12,35 +10,13 @@
 #include "common/eval/evaluation_report.h"
 #include "common/eval/report_html.h"
 
-ABSL_FLAG(std::string, eval, "", "report: folder written by `meshseek eval --out`");
-ABSL_FLAG(int,
-          sample_queries,
-          meshseek::EvaluationReportOptions().sample_queries,
-          "report: queries shown with their top results (one per class)");
-ABSL_FLAG(int,
-          top_results,
-          meshseek::EvaluationReportOptions().top_results,
-          "report: results shown per sampled query");
-ABSL_FLAG(int,
-          thumbnail_size,
-          meshseek::EvaluationReportOptions().thumbnail.size,
-          "report: thumbnail size in pixels");
-ABSL_DECLARE_FLAG(std::string, out);
-ABSL_DECLARE_FLAG(int, threads);
-
 namespace meshseek::cli {
 
-absl::Status RunReport() {
-  const std::string eval_dir = absl::GetFlag(FLAGS_eval);
-  std::string out = absl::GetFlag(FLAGS_out);
+absl::Status RunReport(const CliFlags& flags) {
+  const std::string& eval_dir = flags.eval_dir;
   if (eval_dir.empty()) return absl::InvalidArgumentError("report needs --eval DIR");
-  if (out.empty()) out = eval_dir + "/report.html";
-
-  EvaluationReportOptions options;
-  options.sample_queries = absl::GetFlag(FLAGS_sample_queries);
-  options.top_results = absl::GetFlag(FLAGS_top_results);
-  options.thumbnail.size = absl::GetFlag(FLAGS_thumbnail_size);
-  options.num_threads = absl::GetFlag(FLAGS_threads);
+  const std::string out = flags.out.empty() ? eval_dir + "/report.html" : flags.out;
+  const EvaluationReportOptions& options = flags.report;
   if (absl::Status valid = options.Validate(); !valid.ok()) {
     return absl::InvalidArgumentError(absl::StrCat("flags: ", valid.message()));
   }

@@ -1,30 +1,21 @@
 #include <cstdio>
 #include <string>
 
-#include "absl/flags/declare.h"
-#include "absl/flags/flag.h"
 #include "absl/status/status.h"
 #include "cli/commands.h"
-#include "cli/pipeline_flags.h"
 #include "common/base/status_macros.h"
 #include "common/synth/synthetic_benchmark.h"
 
-ABSL_DECLARE_FLAG(std::string, out);
-ABSL_FLAG(int,
-          models_per_class,
-          meshseek::SyntheticBenchmarkOptions().models_per_class,
-          "synth: models generated per class");
-
 namespace meshseek::cli {
 
-absl::Status RunSynth() {
-  const std::string out_dir = absl::GetFlag(FLAGS_out);
+absl::Status RunSynth(const CliFlags& flags) {
+  const std::string& out_dir = flags.out;
   if (out_dir.empty()) return absl::InvalidArgumentError("synth needs --out DIR");
   SyntheticBenchmarkOptions options;
-  options.models_per_class = absl::GetFlag(FLAGS_models_per_class);
+  options.models_per_class = flags.models_per_class;
   // The synthetic benchmark has its own default seed; --seed (the pipeline
   // parameter, default 0) changes it only when given.
-  MESHSEEK_ASSIGN_OR_RETURN(const RetrievalPipelineOptions pipeline, PipelineOptionsFromFlags());
+  MESHSEEK_ASSIGN_OR_RETURN(const RetrievalPipelineOptions pipeline, flags::PipelineOptionsFromFlags(flags.params));
   if (pipeline.kmeans.seed != 0) options.seed = pipeline.kmeans.seed;
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   MESHSEEK_RETURN_IF_ERROR(GenerateSyntheticBenchmark(options, out_dir));

@@ -7,7 +7,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "cli/session.h"
+#include "common/rpc/client.h"
 #include "cli/web_assets.h"
 #include "common/base/base64.h"
 #include "common/base/json.h"
@@ -200,7 +200,8 @@ class Handlers {
  private:
   template <typename Request, typename Answer, typename Method>
   absl::Status Ask(Method method, const Request& request, Answer* answer) const {
-    return Call(coordinator_, method, request, answer, options_.call_deadline);
+    return rpc::CallWithRetry(coordinator_, method, request, answer, options_.call_deadline,
+                              options_.retry);
   }
 
   void RunQuery(const httplib::Request& request,

@@ -28,6 +28,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "common/rpc/client.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"
 
 namespace httplib {
@@ -48,6 +49,9 @@ struct WebGatewayOptions {
   /// Deadline of each call to the coordinator (a query of a large fused
   /// collection takes seconds).
   absl::Duration call_deadline = absl::Seconds(120);
+  /// Retries of each call while the coordinator is unreachable
+  /// (CoordinatorClient::retry(): --reconnect_for).
+  rpc::RetryOptions retry;
 
   absl::Status Validate() const;
 };

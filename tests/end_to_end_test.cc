@@ -20,6 +20,7 @@ namespace meshseek {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // Small but real settings: every class of the benchmark, fewer points and
 // words than the defaults so the suite stays quick.
@@ -236,8 +237,22 @@ TEST_F(EndToEndTest, CliIngestIntoAnExistingCollectionKeepsItsParameters) {
                        &output),
             0)
       << output;
-  ASSERT_EQ(RunCommand(command("status"), &output), 0) << output;
-  EXPECT_THAT(output, HasSubstr("9 indexed (1 added since the build)"));
+  // What scripts read (protobuf's JSON mapping: uint64 counts are strings),
+  // with the canonical parameters alone: no legacy field, zeroed or not.
+  ASSERT_EQ(RunCommand(command("status") + "--format json", &output), 0) << output;
+  EXPECT_THAT(output, HasSubstr("\"indexed\":\"9\""));
+  EXPECT_THAT(output, HasSubstr("\"added_since_build\":\"1\""));
+  EXPECT_THAT(output, HasSubstr("{\"name\":\"method\",\"value\":\"lsf\"}"));
+  EXPECT_THAT(output, Not(HasSubstr("FEATURE_METHOD_UNSPECIFIED")));
+  EXPECT_THAT(output, Not(HasSubstr("\"kl_epsilon\":0")));
+  EXPECT_THAT(output, Not(HasSubstr("\"vocabulary\":0")));
+  // `status` naming nothing lists the collections.
+  ASSERT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " status --format json --data_dir " + dir +
+                           "/data",
+                       &output),
+            0)
+      << output;
+  EXPECT_THAT(output, HasSubstr("{\"collections\":[{\"name\":\"grow\""));
 }
 
 TEST_F(EndToEndTest, CliRejectsBadFlagsWithAClearMessage) {

@@ -10,9 +10,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
-#include "cli/embedded_stack.h"
+#include "services/embedded/embedded_stack.h"
 #include "common/rpc/client.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 #include "common/rpc/free_port.h"
 #include "common/rpc/metrics_scrape.h"
 #include "common/synth/synthetic_benchmark.h"
@@ -29,7 +29,7 @@ TEST(EmbeddedMetricsTest, OneEndpointCountsModelsByStateIndexedModelsAndEverySer
   const std::string dir = ::testing::TempDir() + "/meshseek_metrics";
   std::filesystem::remove_all(dir);
   const int metrics_port = rpc::FreeLoopbackPort();
-  auto stack = cli::EmbeddedStack::Start(dir, 2, 0, {}, {}, metrics_port);
+  auto stack = EmbeddedStack::Start(dir, 2, 0, {}, {}, metrics_port);
   ASSERT_TRUE(stack.ok()) << stack.status();
   auto stub = v1::Coordinator::NewStub(rpc::MakeChannel((*stack)->coordinator_address()));
   {
@@ -55,7 +55,7 @@ TEST(EmbeddedMetricsTest, OneEndpointCountsModelsByStateIndexedModelsAndEverySer
       v1::IngestRequest request;
       request.set_collection("metered");
       request.set_model_id(absl::StrCat("m", i));
-      rpc::MeshToProto((*models)[i].mesh, request.mutable_mesh()->mutable_mesh());
+      wire::MeshToProto((*models)[i].mesh, request.mutable_mesh()->mutable_mesh());
       ASSERT_TRUE(stream->Write(request));
       v1::IngestAck ack;
       ASSERT_TRUE(stream->Read(&ack));

@@ -15,9 +15,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
-#include "cli/embedded_stack.h"
+#include "services/embedded/embedded_stack.h"
 #include "common/rpc/client.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 #include "common/rpc/server.h"
 #include "common/rpc/status.h"
 #include "common/synth/synthetic_benchmark.h"
@@ -103,12 +103,12 @@ class SecurityTest : public ::testing::Test {
 std::string* SecurityTest::dir_ = nullptr;
 
 TEST_F(SecurityTest, CoordinatorWantsTlsAndTheTokenButHealthIsOpen) {
-  cli::EmbeddedSecurity security;
+  EmbeddedSecurity security;
   security.coordinator.tls.cert_file = File("ca", "tls.crt");
   security.coordinator.tls.key_file = File("ca", "tls.key");
   security.coordinator.token_file = File("ca", "token");
   security.internal = Tls("ca");
-  auto stack = cli::EmbeddedStack::Start(*dir_ + "/data", 2, 0, security);
+  auto stack = EmbeddedStack::Start(*dir_ + "/data", 2, 0, security);
   ASSERT_TRUE(stack.ok()) << stack.status();
   const std::string address = (*stack)->coordinator_address();
 
@@ -157,7 +157,7 @@ TEST_F(SecurityTest, CoordinatorWantsTlsAndTheTokenButHealthIsOpen) {
     v1::IngestRequest request;
     request.set_collection("secure");
     request.set_model_id("m0");
-    rpc::MeshToProto((*models)[0].mesh, request.mutable_mesh()->mutable_mesh());
+    wire::MeshToProto((*models)[0].mesh, request.mutable_mesh()->mutable_mesh());
     ASSERT_TRUE(stream->Write(request));
     stream->WritesDone();
     v1::IngestAck ack;
@@ -213,11 +213,11 @@ TEST_F(SecurityTest, ServiceWithMutualTlsRefusesStrangersAndPlaintext) {
 }
 
 TEST_F(SecurityTest, BadFilesAreNamedAtStart) {
-  cli::EmbeddedSecurity security;
+  EmbeddedSecurity security;
   security.coordinator.tls.cert_file = File("ca", "tls.crt");
   security.coordinator.tls.key_file = File("ca", "tls.key");
   security.coordinator.token_file = File("ca", "no-such-token");
-  auto stack = cli::EmbeddedStack::Start(*dir_ + "/data-bad", 1, 0, security);
+  auto stack = EmbeddedStack::Start(*dir_ + "/data-bad", 1, 0, security);
   ASSERT_FALSE(stack.ok());
   EXPECT_THAT(std::string(stack.status().message()), HasSubstr(File("ca", "no-such-token")));
 }

@@ -27,7 +27,7 @@
 #include "common/pipeline/collection_evaluation.h"
 #include "common/pipeline/pipeline_params.h"
 #include "common/rpc/client.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 #include "common/rpc/free_port.h"
 #include "common/rpc/status.h"
 #include "common/store/sqlite_db.h"
@@ -44,6 +44,7 @@ namespace meshseek {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // CPU seconds (user + system) a process has used, from /proc/PID/stat.
 double CpuSeconds(pid_t pid) {
@@ -240,7 +241,7 @@ class ServicesTest : public ::testing::Test {
   // The in-process matrix of TestParams() over every model.
   static const std::vector<float>& Reference() {
     if (reference_ == nullptr) {
-      auto options = rpc::PipelineOptionsFromParams(TestParams());
+      auto options = wire::PipelineOptionsFromParams(TestParams());
       EXPECT_TRUE(options.ok()) << options.status();
       auto reference = EvaluateCollection(*models_, CollectionOptions::Of(*options));
       EXPECT_TRUE(reference.ok()) << reference.status();
@@ -289,7 +290,7 @@ class ServicesTest : public ::testing::Test {
       request.set_model_id(m.id);
       request.set_label(m.label);
       auto mesh = ReadMesh(m.path);
-      rpc::MeshToProto(*mesh, request.mutable_mesh()->mutable_mesh());
+      wire::MeshToProto(*mesh, request.mutable_mesh()->mutable_mesh());
       if (!stream->Write(request)) break;
     }
     stream->WritesDone();
@@ -364,7 +365,7 @@ class ServicesTest : public ::testing::Test {
     v1::QueryRequest request;
     request.set_collection(collection);
     request.set_top_k(top_k);
-    rpc::MeshToProto(*ReadMesh((*models_)[i].path), request.mutable_mesh()->mutable_mesh());
+    wire::MeshToProto(*ReadMesh((*models_)[i].path), request.mutable_mesh()->mutable_mesh());
     return stub->Query(&context, request, response);
   }
 
@@ -575,7 +576,7 @@ TEST_F(ServicesTest, BadInputGetsTheRightCodeANamedProblemAndServersKeepServing)
     v1::QueryRequest request;
     request.set_collection("good");
     request.set_top_k(3);
-    rpc::MeshToProto(*ReadMesh((*models_)[0].path), request.mutable_mesh()->mutable_mesh());
+    wire::MeshToProto(*ReadMesh((*models_)[0].path), request.mutable_mesh()->mutable_mesh());
     v1::QueryResponse response;
     const grpc::Status status = stub->Query(&context, request, &response);
     ASSERT_TRUE(status.ok()) << status.error_message();
@@ -627,7 +628,7 @@ TEST_F(ServicesTest, AGlobalDescriptorCollectionSurvivesKillsAndEqualsInProcess)
   v1::ParamValue* method = params.add_values();
   method->set_name("method");
   method->set_value("lfd");
-  auto options = rpc::PipelineOptionsFromParams(params);
+  auto options = wire::PipelineOptionsFromParams(params);
   ASSERT_TRUE(options.ok()) << options.status();
   // A third of the models (three classes): LFD renders 100 views per model,
   // slow under the sanitizers.
@@ -717,7 +718,7 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
     v->set_name(name);
     v->set_value(value);
   }
-  auto options = rpc::CollectionOptionsFromParams(params);
+  auto options = wire::CollectionOptionsFromParams(params);
   ASSERT_TRUE(options.ok()) << options.status();
   ASSERT_TRUE(options->fused() && options->rerank.enabled());
   const std::size_t n = models_->size() / 3;
@@ -1060,6 +1061,9 @@ TEST_F(ServicesTest, AModelThatCannotBeExtractedEndsFailedAndTheBuildGoesOnWitho
                                              "\"")));
   EXPECT_THAT(status, HasSubstr("\"state\":\"MODEL_STATE_FAILED\""));
   EXPECT_THAT(status, HasSubstr("\"attempts\":2,\"error\":\"gave up after 2 attempts"));
+  // The canonical parameters only: no zeroed legacy field beside them.
+  EXPECT_THAT(status, Not(HasSubstr("FEATURE_METHOD_UNSPECIFIED")));
+  EXPECT_THAT(status, Not(HasSubstr("\"vocabulary\":0")));
 
   // Nothing left to retry: the coordinator idles.
   const double cpu = CpuSeconds(stack.coordinator().pid());
@@ -1138,7 +1142,7 @@ TEST_F(ServicesTest, ThumbnailsListingAndQueriesByModelServeTheWebPage) {
   EXPECT_EQ(ranked.results(0).model_id(), (*models_)[3].id);
   EXPECT_EQ(ranked.results(0).distance(), 0.0f);
   v1::QueryRequest both = by_model;
-  rpc::MeshToProto(*ReadMesh((*models_)[3].path), both.mutable_mesh()->mutable_mesh());
+  wire::MeshToProto(*ReadMesh((*models_)[3].path), both.mutable_mesh()->mutable_mesh());
   EXPECT_EQ(query(both, &ranked).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   by_model.set_model_id("no-such-model");
   EXPECT_EQ(query(by_model, &ranked).error_code(), grpc::StatusCode::NOT_FOUND);

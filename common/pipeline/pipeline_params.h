@@ -3,8 +3,8 @@
 // lives in RetrievalPipelineOptions (a method's parameters) or
 // CollectionOptions (fusion and re-ranking). Everything that names a parameter
 // follows from this table: the CLI's flags and their help
-// (cli/pipeline_flags), the collection parameters of the services
-// (PipelineParams.values, rpc/convert), their validation and canonical form,
+// (common/flags/pipeline_flags), the collection parameters of the services
+// (PipelineParams.values, wire/convert), their validation and canonical form,
 // and the parameter block of metrics.json. Adding a parameter is one row of
 // the table in pipeline_param_table.cc (and its field in the method's option
 // struct); a new method registers itself in

@@ -5,7 +5,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/base/status_macros.h"
 #include "common/features/sift_descriptor.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 
 namespace meshseek {
 
@@ -94,7 +94,7 @@ absl::StatusOr<v1::CodebookInfo> CodebookService::Train(
   }
   // The same k-means options as the in-process pipeline's
   // TrainCollectionCodebook: the collection's.
-  absl::StatusOr<RetrievalPipelineOptions> params = rpc::PipelineOptionsFromParams(first.params());
+  absl::StatusOr<RetrievalPipelineOptions> params = wire::PipelineOptionsFromParams(first.params());
   if (!params.ok()) return fail(absl::InvalidArgumentError(params.status().message()));
   KMeansOptions kmeans = params->kmeans;
   kmeans.num_threads = options_.num_threads;
@@ -124,7 +124,7 @@ absl::StatusOr<v1::CodebookInfo> CodebookService::Train(
 absl::StatusOr<v1::EncodeResponse> CodebookService::Encode(const v1::EncodeRequest& request,
                                                            const rpc::CallContext&) {
   MESHSEEK_ASSIGN_OR_RETURN(const Entry entry, Find(request.codebook_id()));
-  MESHSEEK_ASSIGN_OR_RETURN(const LocalFeatures features, rpc::FeaturesFromProto(request.features()));
+  MESHSEEK_ASSIGN_OR_RETURN(const LocalFeatures features, wire::FeaturesFromProto(request.features()));
   std::vector<float> histogram;  // empty: a model without features
   if (features.size() > 0) {
     MESHSEEK_ASSIGN_OR_RETURN(
@@ -132,7 +132,7 @@ absl::StatusOr<v1::EncodeResponse> CodebookService::Encode(const v1::EncodeReque
         entry.codebook->Encode(features.descriptors.data(), features.size(), features.dimension));
   }
   v1::EncodeResponse response;
-  rpc::HistogramToProto(histogram, entry.codebook->size(), response.mutable_histogram());
+  wire::HistogramToProto(histogram, entry.codebook->size(), response.mutable_histogram());
   return response;
 }
 

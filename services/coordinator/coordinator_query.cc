@@ -11,7 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 #include "services/coordinator/coordinator_service.h"
 #include "services/coordinator/fused_candidates.h"
 
@@ -49,9 +49,9 @@ absl::StatusOr<v1::Mesh> CoordinatorService::QueryMesh(const v1::QueryRequest& r
                                                       const CollectionPlan& plan) {
   v1::Mesh arrays;
   if (request.model_id().empty()) {
-    absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request.mesh(), options_.mesh_limits);
+    absl::StatusOr<TriangleMesh> mesh = wire::MeshFromProto(request.mesh(), options_.mesh_limits);
     if (!mesh.ok()) return Prefixed(mesh.status(), "query: ");
-    rpc::MeshToProto(*mesh, &arrays);
+    wire::MeshToProto(*mesh, &arrays);
     return arrays;
   }
   // A model of the collection: the mesh it was stored with (already checked

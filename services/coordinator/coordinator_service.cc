@@ -9,7 +9,7 @@
 #include "common/base/status_macros.h"
 #include "common/pipeline/pipeline_params.h"
 #include "common/render/thumbnail.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 
 namespace meshseek {
 namespace {
@@ -152,7 +152,7 @@ absl::StatusOr<v1::Collection> CoordinatorService::CreateCollection(
   MESHSEEK_RETURN_IF_ERROR(CheckName("collection name", request.name(), 128, true));
   const std::string where = absl::StrCat("collection '", request.name(), "'");
   absl::StatusOr<CollectionOptions> valid =
-      rpc::CollectionOptionsFromParams(WithDefaultMethods(request.params()));
+      wire::CollectionOptionsFromParams(WithDefaultMethods(request.params()));
   if (!valid.ok()) return Prefixed(valid.status(), where + ": ");
   for (const RetrievalPipelineOptions& method : valid->methods) {
     if (method.weighting.idf) {
@@ -167,12 +167,12 @@ absl::StatusOr<v1::Collection> CoordinatorService::CreateCollection(
   // keeps its meaning when a default changes, and creating it again with the
   // same parameters however written is not a conflict.
   v1::PipelineParams canonical;
-  rpc::CollectionParamsToProto(*valid, &canonical);
+  wire::CollectionParamsToProto(*valid, &canonical);
   if (absl::StatusOr<StoredCollection> existing = store_->GetCollection(request.name());
       existing.ok()) {
-    absl::StatusOr<CollectionOptions> stored = rpc::CollectionOptionsFromParams(existing->params);
+    absl::StatusOr<CollectionOptions> stored = wire::CollectionOptionsFromParams(existing->params);
     v1::PipelineParams stored_canonical;
-    if (stored.ok()) rpc::CollectionParamsToProto(*stored, &stored_canonical);
+    if (stored.ok()) wire::CollectionParamsToProto(*stored, &stored_canonical);
     if (!stored.ok() || stored_canonical.SerializeAsString() != canonical.SerializeAsString()) {
       return absl::AlreadyExistsError(absl::StrCat(where, " exists with other parameters"));
     }
@@ -182,7 +182,7 @@ absl::StatusOr<v1::Collection> CoordinatorService::CreateCollection(
     if (valid->fused()) {
       for (const RetrievalPipelineOptions& method : valid->methods) {
         v1::PipelineParams params;
-        rpc::PipelineParamsToProto(method, &params);
+        wire::PipelineParamsToProto(method, &params);
         rows.emplace_back(MemberCollectionName(request.name(), method.extractor.method), params);
       }
     }
@@ -234,7 +234,7 @@ absl::StatusOr<v1::Thumbnail> CoordinatorService::GetThumbnail(
     return absl::DataLossError(model + "stored mesh does not parse");
   }
   MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh,
-                            rpc::MeshFromProto(input, options_.mesh_limits));
+                            wire::MeshFromProto(input, options_.mesh_limits));
   absl::StatusOr<std::string> drawn = RenderThumbnailPng(mesh);
   if (!drawn.ok()) {
     return absl::FailedPreconditionError(
@@ -284,10 +284,10 @@ absl::StatusOr<v1::IngestAck> CoordinatorService::AcceptModel(const v1::IngestRe
                                                    request.label().size(),
                                                    " bytes, more than 256"));
   }
-  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request.mesh(), options_.mesh_limits);
+  absl::StatusOr<TriangleMesh> mesh = wire::MeshFromProto(request.mesh(), options_.mesh_limits);
   if (!mesh.ok()) return Prefixed(mesh.status(), absl::StrCat("model ", request.model_id(), ": "));
   v1::Mesh stored;
-  rpc::MeshToProto(*mesh, &stored);
+  wire::MeshToProto(*mesh, &stored);
   // A mesh that cannot be drawn (no extent) is still taken: extraction
   // decides whether it is usable, and says why not.
   CoordinatorStore::ModelThumbnail thumbnail{request.collection(), ""};

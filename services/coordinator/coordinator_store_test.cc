@@ -8,7 +8,7 @@
 #include "absl/time/clock.h"
 #include "common/base/hash.h"
 #include "common/pipeline/retrieval_pipeline.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 #include "common/store/sqlite_db.h"
 #include "services/coordinator/workers.h"
 
@@ -336,7 +336,7 @@ TEST_F(CoordinatorStoreTest, RankingStateIsReplacedByTheNextBuild) {
 TEST_F(CoordinatorStoreTest, ACollectionStoredBeforeWeightingKeepsUnweightedHistograms) {
   auto store = OpenStore();
   v1::PipelineParams params;
-  rpc::PipelineParamsToProto(RetrievalPipelineOptions::ForMethod(FeatureMethod::kLsf), &params);
+  wire::PipelineParamsToProto(RetrievalPipelineOptions::ForMethod(FeatureMethod::kLsf), &params);
   ASSERT_TRUE(store->CreateCollections({{"now", params}}).ok());
   v1::PipelineParams legacy;
   for (const v1::ParamValue& v : params.values()) {

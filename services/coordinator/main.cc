@@ -11,7 +11,7 @@
 #include "absl/flags/usage.h"
 #include "common/rpc/client.h"
 #include "common/rpc/credentials.h"
-#include "common/rpc/mesh_limit_flags.h"
+#include "common/flags/mesh_limit_flags.h"
 #include "common/rpc/server_main.h"
 #include "services/coordinator/coordinator_service.h"
 
@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
       static_cast<std::size_t>(std::max<int64_t>(0, absl::GetFlag(FLAGS_exact_graph_models)));
   options.ranking_graph.graph_candidates = absl::GetFlag(FLAGS_graph_candidates);
   options.ranking_graph.query_candidates = absl::GetFlag(FLAGS_query_candidates);
-  auto limits = meshseek::rpc::MeshLimitsFromFlags();
+  auto limits = meshseek::flags::MeshLimitsFromFlags();
   if (!limits.ok()) return meshseek::rpc::ExitWithError("coordinator", limits.status());
   options.mesh_limits = *limits;
   meshseek::rpc::ClientSecurityOptions outbound;

@@ -6,7 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/base/status_macros.h"
 #include "common/bof/histogram_weighting.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 
 namespace meshseek {
 
@@ -35,7 +35,7 @@ absl::StatusOr<CollectionPlan> LoadCollectionPlan(CoordinatorStore* store,
   plan.params = std::move(stored.params);
   plan.codebook_id = std::move(stored.codebook_id);
   plan.member = IsMemberCollection(name);
-  MESHSEEK_ASSIGN_OR_RETURN(plan.options, rpc::CollectionOptionsFromParams(plan.params));
+  MESHSEEK_ASSIGN_OR_RETURN(plan.options, wire::CollectionOptionsFromParams(plan.params));
   // Stored parameters are complete, so one without histogram_power was
   // created before histograms could be weighted: its index holds them
   // unweighted, and so must its queries be (LSF's default is 0.5 now).
@@ -52,7 +52,7 @@ absl::StatusOr<CollectionPlan> LoadCollectionPlan(CoordinatorStore* store,
     CollectionInfo part;
     part.name = name;
     part.options = plan.options.methods.front();
-    rpc::PipelineParamsToProto(part.options, &part.params);
+    wire::PipelineParamsToProto(part.options, &part.params);
     part.codebook_id = plan.codebook_id;
     plan.parts.push_back(std::move(part));
     return plan;
@@ -63,7 +63,7 @@ absl::StatusOr<CollectionPlan> LoadCollectionPlan(CoordinatorStore* store,
     CollectionInfo part;
     part.name = member;
     part.options = method;
-    rpc::PipelineParamsToProto(method, &part.params);
+    wire::PipelineParamsToProto(method, &part.params);
     part.codebook_id = std::move(part_stored.codebook_id);
     plan.parts.push_back(std::move(part));
   }

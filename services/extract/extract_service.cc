@@ -9,7 +9,7 @@
 #include "absl/time/time.h"
 #include "common/base/status_macros.h"
 #include "common/features/local_feature_extractor.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 
 namespace meshseek {
 
@@ -33,13 +33,13 @@ absl::StatusOr<v1::ExtractResponse> ExtractService::Extract(const v1::ExtractReq
   auto fail = [&where](const absl::Status& status) { return Prefixed(status, where); };
   // Parse and check everything before taking a slot.
   absl::StatusOr<RetrievalPipelineOptions> options =
-      rpc::PipelineOptionsFromParams(request.params());
+      wire::PipelineOptionsFromParams(request.params());
   if (!options.ok()) return fail(options.status());
-  absl::StatusOr<TriangleMesh> mesh = rpc::MeshFromProto(request.mesh(), mesh_limits_);
+  absl::StatusOr<TriangleMesh> mesh = wire::MeshFromProto(request.mesh(), mesh_limits_);
   if (!mesh.ok()) return fail(mesh.status());
   std::optional<PointGraph> graph;
   if (request.has_resampled() && options->extractor.method == FeatureMethod::kRldSift) {
-    absl::StatusOr<PointGraph> parsed = rpc::GraphFromProto(request.resampled());
+    absl::StatusOr<PointGraph> parsed = wire::GraphFromProto(request.resampled());
     if (!parsed.ok()) return fail(parsed.status());
     graph = *std::move(parsed);
   }
@@ -59,7 +59,7 @@ absl::StatusOr<v1::ExtractResponse> ExtractService::Extract(const v1::ExtractReq
   }
   if (!features.ok()) return fail(features.status());
   v1::ExtractResponse response;
-  rpc::FeaturesToProto(*features, response.mutable_features());
+  wire::FeaturesToProto(*features, response.mutable_features());
   return response;
 }
 

@@ -1,10 +1,10 @@
 // meshseek-extract: the stateless local-feature worker. Flags: --workers, the
 // server flags (common/rpc/server_main.h) and the mesh limits
-// (common/rpc/mesh_limit_flags.h).
+// (common/flags/mesh_limit_flags.h).
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
-#include "common/rpc/mesh_limit_flags.h"
+#include "common/flags/mesh_limit_flags.h"
 #include "common/rpc/server_main.h"
 #include "services/extract/extract_service.h"
 
@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
   absl::ParseCommandLine(argc, argv);
   meshseek::ExtractServiceOptions options;
   options.workers = absl::GetFlag(FLAGS_workers);
-  auto limits = meshseek::rpc::MeshLimitsFromFlags();
+  auto limits = meshseek::flags::MeshLimitsFromFlags();
   if (!limits.ok()) return meshseek::rpc::ExitWithError("extract", limits.status());
   options.mesh_limits = *limits;
   if (absl::Status valid = options.Validate(); !valid.ok()) {

@@ -6,7 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 
 namespace meshseek {
 
@@ -79,11 +79,11 @@ absl::StatusOr<std::vector<KlNeighbor>> Distances(const GlobalDescriptorIndex& e
 template <typename Describe>
 void Export(const KlInvertedIndex& engine, Describe&& describe) {
   engine.ForEach([&](uint32_t doc, const SparseHistogram& histogram) {
-    rpc::SparseHistogramToProto(histogram, describe(doc).mutable_histogram());
+    wire::SparseHistogramToProto(histogram, describe(doc).mutable_histogram());
   });
 }
 void ExportOne(const KlInvertedIndex& engine, uint32_t doc, v1::IndexedModel& out) {
-  rpc::SparseHistogramToProto(*engine.Histogram(doc), out.mutable_histogram());  // doc is held
+  wire::SparseHistogramToProto(*engine.Histogram(doc), out.mutable_histogram());  // doc is held
 }
 void ExportOne(const GlobalDescriptorIndex& engine, uint32_t doc, v1::IndexedModel& out) {
   const absl::Span<const uint8_t> bytes = *engine.Descriptor(doc);  // doc is held
@@ -108,7 +108,7 @@ absl::StatusOr<ModelSignature> ModelSignature::Parse(const v1::SparseHistogram& 
                                                      const std::string& what) {
   ModelSignature signature;
   if (descriptor == nullptr) {
-    MESHSEEK_ASSIGN_OR_RETURN(signature.histogram, rpc::SparseHistogramFromProto(histogram, what));
+    MESHSEEK_ASSIGN_OR_RETURN(signature.histogram, wire::SparseHistogramFromProto(histogram, what));
     return signature;
   }
   if (histogram.size() != 0 || histogram.bins_size() != 0) {

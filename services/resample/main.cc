@@ -1,8 +1,8 @@
 // meshseek-resample: the stateless resample worker. Flags: the server flags
-// (common/rpc/server_main.h) and the mesh limits (common/rpc/mesh_limit_flags.h).
+// (common/rpc/server_main.h) and the mesh limits (common/flags/mesh_limit_flags.h).
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
-#include "common/rpc/mesh_limit_flags.h"
+#include "common/flags/mesh_limit_flags.h"
 #include "common/rpc/server_main.h"
 #include "services/resample/resample_service.h"
 
@@ -10,7 +10,7 @@ int main(int argc, char** argv) {
   meshseek::rpc::BlockTerminationSignals();
   absl::SetProgramUsageMessage("meshseek resample worker: mesh -> Sobol point graph");
   absl::ParseCommandLine(argc, argv);
-  auto limits = meshseek::rpc::MeshLimitsFromFlags();
+  auto limits = meshseek::flags::MeshLimitsFromFlags();
   if (!limits.ok()) return meshseek::rpc::ExitWithError("resample", limits.status());
   meshseek::ResampleService service(*limits);
   return meshseek::rpc::ServeUntilSignal("resample", {&service});

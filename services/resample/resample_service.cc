@@ -2,7 +2,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/features/rld_sift.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 #include "common/base/status_macros.h"
 
 namespace meshseek {
@@ -13,12 +13,12 @@ absl::StatusOr<v1::ResampleResponse> ResampleService::Resample(
   limits.num_samples = request.num_samples();
   limits.neighbors = request.neighbors();
   MESHSEEK_RETURN_IF_ERROR(limits.Validate());
-  MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh, rpc::MeshFromProto(request.mesh(), mesh_limits_));
+  MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh, wire::MeshFromProto(request.mesh(), mesh_limits_));
   MESHSEEK_ASSIGN_OR_RETURN(
       const PointGraph graph,
       ResampleSurfaceGraph(mesh, request.num_samples(), request.neighbors()));
   v1::ResampleResponse response;
-  rpc::GraphToProto(graph, response.mutable_graph());
+  wire::GraphToProto(graph, response.mutable_graph());
   return response;
 }
 

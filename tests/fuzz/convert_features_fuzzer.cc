@@ -3,18 +3,18 @@
 #include <cstdint>
 #include <cstdlib>
 
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   meshseek::v1::LocalFeatures message;
   if (!message.ParseFromArray(data, static_cast<int>(size))) return 0;
   const absl::StatusOr<meshseek::LocalFeatures> features =
-      meshseek::rpc::FeaturesFromProto(message);
+      meshseek::wire::FeaturesFromProto(message);
   if (!features.ok()) return 0;
   if (features->descriptors.size() != features->size() * features->dimension) std::abort();
   meshseek::v1::LocalFeatures back;
-  meshseek::rpc::FeaturesToProto(*features, &back);
-  const absl::StatusOr<meshseek::LocalFeatures> again = meshseek::rpc::FeaturesFromProto(back);
+  meshseek::wire::FeaturesToProto(*features, &back);
+  const absl::StatusOr<meshseek::LocalFeatures> again = meshseek::wire::FeaturesFromProto(back);
   if (!again.ok() || again->size() != features->size()) std::abort();
   return 0;
 }

@@ -3,13 +3,13 @@
 #include <cstdint>
 #include <cstdlib>
 
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   meshseek::v1::SparseHistogram message;
   if (!message.ParseFromArray(data, static_cast<int>(size))) return 0;
   const absl::StatusOr<meshseek::SparseHistogram> histogram =
-      meshseek::rpc::SparseHistogramFromProto(message, "model 'fuzz'");
+      meshseek::wire::SparseHistogramFromProto(message, "model 'fuzz'");
   if (!histogram.ok()) {
     if (histogram.status().message().find("model 'fuzz'") == absl::string_view::npos) {
       std::abort();
@@ -17,9 +17,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     return 0;
   }
   meshseek::v1::SparseHistogram back;
-  meshseek::rpc::SparseHistogramToProto(*histogram, &back);
+  meshseek::wire::SparseHistogramToProto(*histogram, &back);
   const absl::StatusOr<meshseek::SparseHistogram> again =
-      meshseek::rpc::SparseHistogramFromProto(back, "model 'fuzz'");
+      meshseek::wire::SparseHistogramFromProto(back, "model 'fuzz'");
   if (!again.ok() || again->words != histogram->words) std::abort();
   return 0;
 }

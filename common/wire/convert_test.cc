@@ -1,4 +1,4 @@
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 
 #include <limits>
 #include <string>
@@ -7,7 +7,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
-namespace meshseek::rpc {
+namespace meshseek::wire {
 namespace {
 
 TEST(ConvertTest, MeshRoundTripsExactly) {
@@ -256,4 +256,4 @@ TEST(ConvertTest, UnsetParamsAreTheCoreDefaults) {
 }
 
 }  // namespace
-}  // namespace meshseek::rpc
+}  // namespace meshseek::wire

@@ -1,4 +1,4 @@
-#include "common/rpc/mesh_limit_flags.h"
+#include "common/flags/mesh_limit_flags.h"
 
 #include <cstdint>
 
@@ -16,7 +16,7 @@ ABSL_FLAG(uint64_t, max_mesh_vertices, kDefaults.max_vertices,
 ABSL_FLAG(uint64_t, max_mesh_triangles, kDefaults.max_triangles,
           "most triangles a mesh may hold after fan triangulation of its polygons");
 
-namespace meshseek::rpc {
+namespace meshseek::flags {
 
 absl::StatusOr<MeshReadOptions> MeshLimitsFromFlags() {
   MeshReadOptions options;
@@ -34,4 +34,4 @@ absl::StatusOr<MeshReadOptions> MeshLimitsFromFlags() {
   return options;
 }
 
-}  // namespace meshseek::rpc
+}  // namespace meshseek::flags

@@ -1,4 +1,4 @@
-#include "cli/pipeline_flags.h"
+#include "common/flags/pipeline_flags.h"
 
 #include <algorithm>
 #include <optional>
@@ -13,30 +13,15 @@
 #include "absl/strings/str_join.h"
 #include "common/base/status_macros.h"
 #include "common/pipeline/pipeline_params.h"
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 
 ABSL_FLAG(int, threads, 0, "threads (0: all cores)");
 ABSL_FLAG(bool, progress, true, "show progress bars on stderr");
 
-namespace meshseek::cli {
-namespace {
+namespace meshseek::flags {
 
-// The parameters given on the command line, in order.
-ParamValues& GivenValues() {
-  static auto* const values = new ParamValues();
-  return *values;
-}
-
-// A missing value after the last `--name`: reported when options are asked
-// for, naming the parameter.
-std::string& MissingValue() {
-  static auto* const missing = new std::string();
-  return *missing;
-}
-
-}  // namespace
-
-std::vector<char*> ParseCommandLineWithParams(int argc, char** argv, absl::string_view usage) {
+CommandLine ParseCommandLineWithParams(int argc, char** argv, absl::string_view usage) {
+  CommandLine line;
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
     const absl::string_view arg = argv[i];
@@ -58,45 +43,50 @@ std::vector<char*> ParseCommandLineWithParams(int argc, char** argv, absl::strin
     }
     if (!has_value) {
       if (i + 1 >= argc) {
-        MissingValue() = std::string(name);
+        line.params.missing_value = std::string(name);
         continue;
       }
       value = argv[++i];
     }
-    GivenValues().emplace_back(std::string(name), value);
+    line.params.given.emplace_back(std::string(name), value);
   }
   absl::SetProgramUsageMessage(absl::StrCat(usage, "\n\n", PipelineParamsUsage()));
   int rest_argc = static_cast<int>(rest.size());
   rest.push_back(nullptr);
-  return absl::ParseCommandLine(rest_argc, rest.data());
+  line.positional = absl::ParseCommandLine(rest_argc, rest.data());
+  line.params.threads = absl::GetFlag(FLAGS_threads);
+  line.params.progress = absl::GetFlag(FLAGS_progress);
+  return line;
 }
 
 namespace {
 
 // The options of `values` with the run flags; errors name the flags.
-absl::StatusOr<CollectionOptions> OptionsOf(const ParamValues& values) {
-  if (!MissingValue().empty()) {
-    return absl::InvalidArgumentError(absl::StrCat("--", MissingValue(), " needs a value"));
+absl::StatusOr<CollectionOptions> OptionsOf(const ParamFlags& flags, const ParamValues& values) {
+  if (!flags.missing_value.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat("--", flags.missing_value, " needs a value"));
   }
   absl::StatusOr<CollectionOptions> options = CollectionOptionsFromValues(values);
   if (!options.ok()) {
     return absl::InvalidArgumentError(absl::StrCat("flags: ", options.status().message()));
   }
-  options->SetRunOptions(absl::GetFlag(FLAGS_threads), absl::GetFlag(FLAGS_progress));
+  options->SetRunOptions(flags.threads, flags.progress);
   return options;
 }
 
 }  // namespace
 
-absl::StatusOr<CollectionOptions> CollectionOptionsFromFlags() { return OptionsOf(GivenValues()); }
+absl::StatusOr<CollectionOptions> CollectionOptionsFromFlags(const ParamFlags& flags) {
+  return OptionsOf(flags, flags.given);
+}
 
-absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags() {
+absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags(const ParamFlags& flags) {
   // A command of one method that names none works with kDefaultSingleMethod.
-  ParamValues values = GivenValues();
+  ParamValues values = flags.given;
   if (std::none_of(values.begin(), values.end(), [](const auto& v) { return v.first == "method"; })) {
     values.insert(values.begin(), {"method", kDefaultSingleMethod});
   }
-  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, OptionsOf(values));
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, OptionsOf(flags, values));
   if (options.fused() || options.rerank.enabled()) {
     return absl::InvalidArgumentError(
         absl::StrCat("flags: this command works with one method, got --method ",
@@ -106,17 +96,19 @@ absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromFlags() {
   return options.methods.front();
 }
 
-absl::StatusOr<v1::PipelineParams> CollectionParamsFromFlags() {
-  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromFlags());
+absl::StatusOr<v1::PipelineParams> CollectionParamsFromFlags(const ParamFlags& flags) {
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionOptions options, CollectionOptionsFromFlags(flags));
   v1::PipelineParams params;
-  rpc::CollectionParamsToProto(options, &params);
+  wire::CollectionParamsToProto(options, &params);
   return params;
 }
 
-absl::Status CheckFlagsAgreeWith(const v1::PipelineParams& params, absl::string_view collection) {
-  if (GivenValues().empty()) return absl::OkStatus();
-  if (!MissingValue().empty()) {
-    return absl::InvalidArgumentError(absl::StrCat("--", MissingValue(), " needs a value"));
+absl::Status CheckFlagsAgreeWith(const ParamFlags& flags,
+                                 const v1::PipelineParams& params,
+                                 absl::string_view collection) {
+  if (flags.given.empty()) return absl::OkStatus();
+  if (!flags.missing_value.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat("--", flags.missing_value, " needs a value"));
   }
   const auto value_in = [](const v1::PipelineParams& p,
                            const std::string& name) -> std::optional<std::string> {
@@ -133,7 +125,7 @@ absl::Status CheckFlagsAgreeWith(const v1::PipelineParams& params, absl::string_
   };
   // The flags read as they would be for this collection's methods (unless
   // they name others), both sides canonical: "--scale 0.10" agrees with 0.1.
-  ParamValues values = GivenValues();
+  ParamValues values = flags.given;
   const bool method_given = std::any_of(values.begin(), values.end(),
                                         [](const auto& v) { return v.first == "method"; });
   if (!method_given && value_in(params, "method").has_value()) {
@@ -142,9 +134,9 @@ absl::Status CheckFlagsAgreeWith(const v1::PipelineParams& params, absl::string_
   absl::StatusOr<CollectionOptions> options = CollectionOptionsFromValues(values);
   if (!options.ok()) return conflict(options.status().message());
   v1::PipelineParams given;
-  rpc::CollectionParamsToProto(*options, &given);
+  wire::CollectionParamsToProto(*options, &given);
   std::vector<std::string> problems;
-  for (const auto& [name, unused] : GivenValues()) {
+  for (const auto& [name, unused] : flags.given) {
     const std::optional<std::string> stored = value_in(params, name);
     const std::optional<std::string> asked = value_in(given, name);
     if (!stored.has_value()) {
@@ -158,4 +150,4 @@ absl::Status CheckFlagsAgreeWith(const v1::PipelineParams& params, absl::string_
   return conflict(absl::StrJoin(problems, "; "));
 }
 
-}  // namespace meshseek::cli
+}  // namespace meshseek::flags

@@ -1,4 +1,4 @@
-#include "common/rpc/convert.h"
+#include "common/wire/convert.h"
 
 #include <cmath>
 #include <cstdint>
@@ -9,7 +9,7 @@
 #include "common/geometry/mesh_io.h"
 #include "common/pipeline/pipeline_params.h"
 
-namespace meshseek::rpc {
+namespace meshseek::wire {
 namespace {
 
 std::optional<MeshFormat> FormatOf(v1::MeshFormat format) {
@@ -331,4 +331,4 @@ void PipelineParamsToProto(const RetrievalPipelineOptions& options, v1::Pipeline
   ValuesToProto(PipelineValuesOf(options), out);
 }
 
-}  // namespace meshseek::rpc
+}  // namespace meshseek::wire

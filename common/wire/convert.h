@@ -2,8 +2,8 @@
 // Every conversion from the wire checks what the core relies on and returns
 // InvalidArgument naming the field and the bad value; conversions to the wire
 // cannot fail.
-#ifndef MESHSEEK_COMMON_RPC_CONVERT_H_
-#define MESHSEEK_COMMON_RPC_CONVERT_H_
+#ifndef MESHSEEK_COMMON_WIRE_CONVERT_H_
+#define MESHSEEK_COMMON_WIRE_CONVERT_H_
 
 #include <string>
 #include <vector>
@@ -18,7 +18,7 @@
 #include "common/search/sparse_histogram.h"
 #include "meshseek/v1/types.pb.h"
 
-namespace meshseek::rpc {
+namespace meshseek::wire {
 
 // A mesh from arrays or from a file's bytes (read by the same readers as
 // ReadMesh; errors name the file by MeshFile.name), within `limits`.
@@ -60,6 +60,6 @@ absl::StatusOr<RetrievalPipelineOptions> PipelineOptionsFromParams(const v1::Pip
 // The canonical parameters of one method as a collection of its own.
 void PipelineParamsToProto(const RetrievalPipelineOptions& options, v1::PipelineParams* out);
 
-}  // namespace meshseek::rpc
+}  // namespace meshseek::wire
 
-#endif  // MESHSEEK_COMMON_RPC_CONVERT_H_
+#endif  // MESHSEEK_COMMON_WIRE_CONVERT_H_

@@ -3,8 +3,8 @@
 // (DATA/codebook, DATA/index, DATA/coordinator). The CLI starts it when no
 // --server is given, talks to it over gRPC exactly as to a cluster, and stops
 // it at exit; state persists between runs. `meshseek serve` keeps it running.
-#ifndef MESHSEEK_CLI_EMBEDDED_STACK_H_
-#define MESHSEEK_CLI_EMBEDDED_STACK_H_
+#ifndef MESHSEEK_SERVICES_EMBEDDED_EMBEDDED_STACK_H_
+#define MESHSEEK_SERVICES_EMBEDDED_EMBEDDED_STACK_H_
 
 #include <memory>
 #include <string>
@@ -18,7 +18,7 @@
 #include "services/index/index_service.h"
 #include "services/resample/resample_service.h"
 
-namespace meshseek::cli {
+namespace meshseek {
 
 struct EmbeddedSecurity {
   /// TLS, client certificates and bearer token of the coordinator's port
@@ -62,6 +62,6 @@ class EmbeddedStack {
   std::string coordinator_address_;
 };
 
-}  // namespace meshseek::cli
+}  // namespace meshseek
 
-#endif  // MESHSEEK_CLI_EMBEDDED_STACK_H_
+#endif  // MESHSEEK_SERVICES_EMBEDDED_EMBEDDED_STACK_H_

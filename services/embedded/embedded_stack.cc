@@ -1,10 +1,10 @@
-#include "cli/embedded_stack.h"
+#include "services/embedded/embedded_stack.h"
 
 #include "absl/strings/str_cat.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
 
-namespace meshseek::cli {
+namespace meshseek {
 
 absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(
     const std::string& data_dir,
@@ -64,4 +64,4 @@ EmbeddedStack::~EmbeddedStack() {
   for (auto& server : servers_) server->Shutdown();
 }
 
-}  // namespace meshseek::cli
+}  // namespace meshseek

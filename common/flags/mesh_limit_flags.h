@@ -8,17 +8,17 @@
 // A file over a limit is refused with RESOURCE_EXHAUSTED naming the limit; a
 // file whose header promises more than its bytes hold is INVALID_ARGUMENT
 // whatever the limits.
-#ifndef MESHSEEK_COMMON_RPC_MESH_LIMIT_FLAGS_H_
-#define MESHSEEK_COMMON_RPC_MESH_LIMIT_FLAGS_H_
+#ifndef MESHSEEK_COMMON_FLAGS_MESH_LIMIT_FLAGS_H_
+#define MESHSEEK_COMMON_FLAGS_MESH_LIMIT_FLAGS_H_
 
 #include "absl/status/statusor.h"
 #include "common/geometry/mesh_io.h"
 
-namespace meshseek::rpc {
+namespace meshseek::flags {
 
 /// MeshReadOptions from the flags, validated (InvalidArgument naming the flag).
 absl::StatusOr<MeshReadOptions> MeshLimitsFromFlags();
 
-}  // namespace meshseek::rpc
+}  // namespace meshseek::flags
 
-#endif  // MESHSEEK_COMMON_RPC_MESH_LIMIT_FLAGS_H_
+#endif  // MESHSEEK_COMMON_FLAGS_MESH_LIMIT_FLAGS_H_
