@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "cli/commands.h"
 #include "cli/coordinator_client.h"
 #include "cli/output_format.h"
@@ -93,6 +94,15 @@ absl::Status RunQuery(const CliFlags& flags, const std::string& model_path) {
   for (const v1::ScoredModel& r : response.results()) {
     std::printf("%4d  %-24s %-16s %.6g\n", ++rank, r.model_id().c_str(), r.label().c_str(), r.distance());
   }
+  const v1::QueryTimings& t = response.timings();
+  std::string methods;
+  for (const v1::MethodTiming& m : t.methods()) {
+    absl::StrAppendFormat(&methods, "%s%s %.0f + %.0f", methods.empty() ? "" : ", ", m.method(),
+                          1e3 * m.extract_seconds(), 1e3 * m.encode_seconds());
+  }
+  std::printf("coordinator: mesh %.0f ms, extract + encode %.0f ms (%s), search %.0f ms\n",
+              1e3 * t.mesh_seconds(), 1e3 * t.signatures_seconds(), methods.c_str(),
+              1e3 * t.search_seconds());
   return absl::OkStatus();
 }
 

@@ -15,7 +15,6 @@
 #include <fstream>
 #include <map>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
@@ -30,6 +29,7 @@
 #include "common/geometry/principal_axes.h"
 #include "common/geometry/triangle_bvh.h"
 #include "common/global/lfd_cameras.h"
+#include "common/render/png.h"
 #include "common/render/view_renderer.h"
 
 
@@ -123,9 +123,7 @@ absl::Status WriteOverview(const std::string& path,
                LevelColour(k.level),
                cv::FILLED);
   }
-  if (!cv::imwrite(path, canvas))
-    return absl::PermissionDeniedError(absl::StrCat(path, ": cannot write"));
-  return absl::OkStatus();
+  return WritePng(path, canvas);
 }
 
 absl::Status WriteMontage(const std::string& path,
@@ -152,9 +150,7 @@ absl::Status WriteMontage(const std::string& path,
     colour.copyTo(montage(
         cv::Rect((i % columns) * cell + 2, (i / columns) * cell + 2, colour.cols, colour.rows)));
   }
-  if (!cv::imwrite(path, montage))
-    return absl::PermissionDeniedError(absl::StrCat(path, ": cannot write"));
-  return absl::OkStatus();
+  return WritePng(path, montage);
 }
 
 // The whole-model views of bfdsift (depth, with the points sampled in each)
@@ -205,9 +201,7 @@ absl::Status WriteViews(const std::string& path,
                                   n,
                                   n)));
   }
-  if (!cv::imwrite(path, montage))
-    return absl::PermissionDeniedError(absl::StrCat(path, ": cannot write"));
-  return absl::OkStatus();
+  return WritePng(path, montage);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@ PACKAGES=(
   libabsl-dev                                        # Status, flags, strings
   libopenmesh-dev                                    # mesh file readers
   libopencv-dev                                      # SIFT descriptor (features2d)
+  libpng-dev                                         # PNG thumbnails and pictures (not OpenCV's imgcodecs: 65 ms a process start)
   libflann-dev liblz4-dev                            # k-nearest-neighbour graph (RLD-SIFT)
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # services
   libsqlite3-dev                                     # state of the stateful services

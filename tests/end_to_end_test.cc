@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -195,6 +196,39 @@ TEST_F(EndToEndTest, CliNamesTheModelAndLineOfABadMeshAndFailsCleanly) {
 // say how to create one, a conflicting or inapplicable flag is an error
 // naming it, and a model added after the build is searchable (status counts
 // it) with no build.
+// `meshseek serve` on a data folder, in the background for the object's
+// lifetime: commands then name it with --server, as a user's would, and run
+// no services of their own.
+class Served {
+ public:
+  explicit Served(const std::string& data_dir) {
+    const std::string command = "sh -c 'echo $$; exec " + std::string(MESHSEEK_CLI_PATH) +
+                                " serve --port 0 --data_dir " + data_dir + "' 2>/dev/null";
+    pipe_ = popen(command.c_str(), "r");
+    char line[512];
+    if (pipe_ != nullptr && fgets(line, sizeof line, pipe_) != nullptr) pid_ = std::atoi(line);
+    // "meshseek serving on 127.0.0.1:PORT (data in ...); Ctrl-C stops"
+    if (pid_ > 0 && fgets(line, sizeof line, pipe_) != nullptr) {
+      std::istringstream words(line);
+      std::string word;
+      while (words >> word && word != "on") {
+      }
+      words >> address_;
+    }
+  }
+  ~Served() {
+    if (pid_ > 0) kill(pid_, SIGTERM);
+    if (pipe_ != nullptr) pclose(pipe_);
+  }
+  // host:port, empty when it did not start.
+  const std::string& address() const { return address_; }
+
+ private:
+  FILE* pipe_ = nullptr;
+  int pid_ = 0;
+  std::string address_;
+};
+
 TEST_F(EndToEndTest, CliIngestIntoAnExistingCollectionKeepsItsParameters) {
   const std::string dir = *dir_ + "/grow";
   std::filesystem::create_directories(dir);
@@ -238,8 +272,13 @@ TEST_F(EndToEndTest, CliIngestIntoAnExistingCollectionKeepsItsParameters) {
             0)
       << output;
   // What scripts read (protobuf's JSON mapping: uint64 counts are strings),
-  // with the canonical parameters alone: no legacy field, zeroed or not.
-  ASSERT_EQ(RunCommand(command("status") + "--format json", &output), 0) << output;
+  // with the canonical parameters alone: no legacy field, zeroed or not; of
+  // a running server, as scripts ask.
+  const Served served(dir + "/data");
+  ASSERT_FALSE(served.address().empty());
+  const std::string status = std::string(MESHSEEK_CLI_PATH) + " status --format json --server " +
+                             served.address();
+  ASSERT_EQ(RunCommand(status + " --collection grow", &output), 0) << output;
   EXPECT_THAT(output, HasSubstr("\"indexed\":\"9\""));
   EXPECT_THAT(output, HasSubstr("\"added_since_build\":\"1\""));
   EXPECT_THAT(output, HasSubstr("{\"name\":\"method\",\"value\":\"lsf\"}"));
@@ -247,11 +286,7 @@ TEST_F(EndToEndTest, CliIngestIntoAnExistingCollectionKeepsItsParameters) {
   EXPECT_THAT(output, Not(HasSubstr("\"kl_epsilon\":0")));
   EXPECT_THAT(output, Not(HasSubstr("\"vocabulary\":0")));
   // `status` naming nothing lists the collections.
-  ASSERT_EQ(RunCommand(std::string(MESHSEEK_CLI_PATH) + " status --format json --data_dir " + dir +
-                           "/data",
-                       &output),
-            0)
-      << output;
+  ASSERT_EQ(RunCommand(status, &output), 0) << output;
   EXPECT_THAT(output, HasSubstr("{\"collections\":[{\"name\":\"grow\""));
 }
 

@@ -807,6 +807,15 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
     EXPECT_EQ(found.results(0).model_id(), (*models_)[n].id)
         << "not searchable " << absl::FormatDuration(absl::Now() - extracted)
         << " after its extraction ended";
+    // The stages apart, one entry per member in the collection's order.
+    ASSERT_EQ(found.timings().methods_size(), static_cast<int>(options->methods.size()));
+    for (int m = 0; m < found.timings().methods_size(); ++m) {
+      EXPECT_EQ(found.timings().methods(m).method(),
+                FeatureMethodName(options->methods[m].extractor.method));
+      EXPECT_GT(found.timings().methods(m).extract_seconds(), 0);
+    }
+    EXPECT_GT(found.timings().signatures_seconds(), 0);
+    EXPECT_GT(found.timings().search_seconds(), 0);
     grpc::ClientContext context;
     v1::GetCollectionRequest get;
     get.set_name("fused");

@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "common/base/status_macros.h"
+#include "common/render/png.h"
 #include "common/render/view_renderer.h"
 
 namespace meshseek {
@@ -91,11 +91,7 @@ absl::StatusOr<std::string> RenderThumbnailPng(const TriangleMesh& mesh,
       out[3] = cv::saturate_cast<uint8_t>(255.0f * alpha);
     }
   }
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", bgra, png)) {
-    return absl::InternalError("thumbnail: PNG encoding failed");
-  }
-  return std::string(png.begin(), png.end());
+  return EncodePng(bgra);
 }
 
 }  // namespace meshseek

@@ -2,18 +2,18 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <vector>
 
 #include "common/geometry/test_meshes.h"
+#include "common/render/png.h"
 #include "common/render/view_renderer.h"
 
 namespace meshseek {
 namespace {
 
 cv::Mat Decode(const std::string& png) {
-  const std::vector<uchar> bytes(png.begin(), png.end());
-  return cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+  absl::StatusOr<cv::Mat> image = DecodePng(png);
+  return image.ok() ? *image : cv::Mat();
 }
 
 TEST(ThumbnailTest, DefaultOptionsAreValid) { EXPECT_TRUE(ThumbnailOptions().Validate().ok()); }

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
 #include "common/wire/convert.h"
@@ -70,20 +71,30 @@ absl::StatusOr<v1::Mesh> CoordinatorService::QueryMesh(const v1::QueryRequest& r
 }
 
 absl::StatusOr<std::vector<IndexSignature>> CoordinatorService::QuerySignatures(
-    const v1::Mesh& mesh, const CollectionPlan& plan, uint32_t* features) {
+    const v1::Mesh& mesh, const CollectionPlan& plan, uint32_t* features,
+    v1::QueryTimings* timings) {
   const std::size_t parts = plan.parts.size();
   std::vector<absl::StatusOr<IndexSignature>> encoded(parts, absl::UnknownError(""));
   std::vector<uint32_t> counts(parts, 0);
+  std::vector<v1::MethodTiming> times(parts);
+  const absl::Time start = absl::Now();
   ParallelFor(parts, static_cast<int>(parts), [&](std::size_t p) {
     const CollectionInfo& part = plan.parts[p];
+    times[p].set_method(FeatureMethodName(part.options.extractor.method));
+    const absl::Time extract_start = absl::Now();
     absl::StatusOr<v1::LocalFeatures> extracted = workers_.Extract(mesh, part, "query");
+    const absl::Time encode_start = absl::Now();
+    times[p].set_extract_seconds(absl::ToDoubleSeconds(encode_start - extract_start));
     if (!extracted.ok()) {
       encoded[p] = extracted.status();
       return;
     }
     counts[p] = extracted->count();
     encoded[p] = workers_.Encode(part, part.codebook_id, *extracted);
+    times[p].set_encode_seconds(absl::ToDoubleSeconds(absl::Now() - encode_start));
   });
+  timings->set_signatures_seconds(absl::ToDoubleSeconds(absl::Now() - start));
+  for (v1::MethodTiming& t : times) *timings->add_methods() = std::move(t);
   std::vector<IndexSignature> signatures;
   *features = 0;
   for (std::size_t p = 0; p < parts; ++p) {
@@ -102,12 +113,16 @@ absl::StatusOr<v1::QueryResponse> CoordinatorService::Query(const v1::QueryReque
   if (request.top_k() == 0) return absl::InvalidArgumentError("query: top_k must be at least 1");
   MESHSEEK_ASSIGN_OR_RETURN(const CollectionPlan plan, PublicPlan(request.collection()));
   MESHSEEK_RETURN_IF_ERROR(CheckQueryFlags(request, plan));
-  MESHSEEK_ASSIGN_OR_RETURN(const v1::Mesh mesh, QueryMesh(request, plan));
   v1::QueryResponse response;
+  v1::QueryTimings& timings = *response.mutable_timings();
+  const absl::Time start = absl::Now();
+  MESHSEEK_ASSIGN_OR_RETURN(const v1::Mesh mesh, QueryMesh(request, plan));
+  timings.set_mesh_seconds(absl::ToDoubleSeconds(absl::Now() - start));
   uint32_t features = 0;
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<IndexSignature> signatures,
-                            QuerySignatures(mesh, plan, &features));
+                            QuerySignatures(mesh, plan, &features, &timings));
   response.set_query_features(features);
+  const absl::Time search_start = absl::Now();
 
   std::vector<v1::ScoredModel> found;
   if (!plan.options.rescaled()) {
@@ -150,6 +165,7 @@ absl::StatusOr<v1::QueryResponse> CoordinatorService::Query(const v1::QueryReque
     MESHSEEK_ASSIGN_OR_RETURN(found, ranking->ranking.Query(distances, plan.options, request.top_k()));
   }
   for (v1::ScoredModel& m : found) *response.add_results() = std::move(m);
+  timings.set_search_seconds(absl::ToDoubleSeconds(absl::Now() - search_start));
   return response;
 }
 

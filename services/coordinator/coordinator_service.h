@@ -133,11 +133,12 @@ class CoordinatorService final : public v1::Coordinator::Service {
   // Ingest of one model: validates, stores, returns the ack.
   // Query: the query's mesh (given, or a stored model's) as arrays, and
   // each part's signature of it (the parts extracted in parallel), with the
-  // number of local features they found.
+  // number of local features they found and the stages' times.
   absl::StatusOr<v1::Mesh> QueryMesh(const v1::QueryRequest& request, const CollectionPlan& plan);
   absl::StatusOr<std::vector<IndexSignature>> QuerySignatures(const v1::Mesh& mesh,
                                                               const CollectionPlan& plan,
-                                                              uint32_t* features);
+                                                              uint32_t* features,
+                                                              v1::QueryTimings* timings);
   absl::StatusOr<v1::IngestAck> AcceptModel(const v1::IngestRequest& request,
                                             const std::vector<std::string>& parts,
                                             const std::string& job_id);
