@@ -141,53 +141,72 @@ ParamSpec MethodParam() {
   return method;
 }
 
-// The sub-options a parameter shares between methods, of the selected method.
-DepthImageOptions& DepthImage(Options& o) {
-  switch (o.extractor.method) {
-    case kLd:
-      return o.extractor.ld.depth_image;
-    case kRld:
-      return o.extractor.rld.depth_image;
-    case kBf:
-      return o.extractor.bfdsift.patch_image;
-    default:
-      return o.extractor.dld.depth_image;
-  }
-}
-SiftDescriptorOptions& Sift(Options& o) {
-  switch (o.extractor.method) {
-    case kLd:
-      return o.extractor.ld.descriptor;
-    case kRld:
-      return o.extractor.rld.descriptor;
-    case kBf:
-      return o.extractor.bfdsift.descriptor;
-    default:
-      return o.extractor.dld.descriptor;
-  }
-}
-ScaleSpaceOptions& ScaleSpace(Options& o) {
-  return o.extractor.method == kLd ? o.extractor.ld.scale_space : o.extractor.rld.scale_space;
-}
-bool IsLsf(const Options& o) { return o.extractor.method == kLsf; }
-
 // The field a row's parameter lives in.
 #define OF(field) +[](Options & o) -> auto& { return field; }
+
+// A parameter that lives in a different field of each method's options: a
+// table of (method, field) rows, looked up by the selected method. The
+// parameter applies to exactly these methods (its Only() column), so the
+// lookup always finds its row; the first row answers otherwise.
+template <typename T>
+class MethodFields {
+ public:
+  struct Row {
+    FeatureMethod method;
+    T& (*field)(Options&);
+  };
+  MethodFields(std::initializer_list<Row> rows) : rows_(rows) {}
+  T& Of(Options& o) const {
+    for (const Row& row : rows_) {
+      if (row.method == o.extractor.method) return row.field(o);
+    }
+    return rows_.front().field(o);
+  }
+
+ private:
+  std::vector<Row> rows_;
+};
+
+// The sub-options and fields parameters share between methods.
+const MethodFields<DepthImageOptions> kDepthImage = {
+    {kDld, OF(o.extractor.dld.depth_image)},
+    {kLd, OF(o.extractor.ld.depth_image)},
+    {kRld, OF(o.extractor.rld.depth_image)},
+    {kBf, OF(o.extractor.bfdsift.patch_image)}};
+const MethodFields<SiftDescriptorOptions> kSift = {
+    {kDld, OF(o.extractor.dld.descriptor)},
+    {kLd, OF(o.extractor.ld.descriptor)},
+    {kRld, OF(o.extractor.rld.descriptor)},
+    {kBf, OF(o.extractor.bfdsift.descriptor)}};
+const MethodFields<ScaleSpaceOptions> kScaleSpace = {
+    {kRld, OF(o.extractor.rld.scale_space)},
+    {kLd, OF(o.extractor.ld.scale_space)}};
+const MethodFields<double> kScale = {
+    {kDld, OF(o.extractor.dld.scale)},
+    {kLsf, OF(o.extractor.lsf.scale)}};
+const MethodFields<int> kPoints = {
+    {kDld, OF(o.extractor.dld.num_points)},
+    {kLsf, OF(o.extractor.lsf.num_points)}};
+const MethodFields<bool> kWeightedFrame = {
+    {kDld, OF(o.extractor.dld.weighted_frame)},
+    {kRld, OF(o.extractor.rld.weighted_frame)}};
+const MethodFields<int> kViewSize = {
+    {kBf, OF(o.extractor.bfdsift.view_size)},
+    {kLfd, OF(o.extractor.lfd.image_size)}};
+
 #define OF_COLLECTION(field) +[](CollectionOptions & o) -> auto& { return field; }
 
-std::vector<ParamSpec> MakeTable() {
-  using Assignment = KMeansOptions::Assignment;
-  using Rerank = RerankOptions::Method;
-  const double kMaxSeed = static_cast<double>(std::numeric_limits<uint64_t>::max());
+// The rows of the features: where they are, the views, the depth images.
+std::vector<ParamSpec> FeatureRows() {
   // clang-format off
   return {
     MethodParam(),
     // Where the features are, and their support.
     Param("scale", Range(1e-6, 2), Only({kDld, kLsf}),
-          OF(IsLsf(o) ? o.extractor.lsf.scale : o.extractor.dld.scale),
+          OF(kScale.Of(o)),
           "support radius E relative to the minimum enclosing sphere (s = E * D / 2)"),
     Param("points", Range(1, 1000000), Only({kDld, kLsf}),
-          OF(IsLsf(o) ? o.extractor.lsf.num_points : o.extractor.dld.num_points),
+          OF(kPoints.Of(o)),
           "feature points per model (N_DLD, LSF's centres)"),
     Param("extra_scales", Range(1e-6, 2), Only({kLsf}), OF(o.extractor.lsf.extra_scales),
           "further support radii (as scale), every centre described at each"),
@@ -202,21 +221,21 @@ std::vector<ParamSpec> MakeTable() {
     Param("frame_radius", Range(0.25, 4), Only({kDld}), OF(o.extractor.dld.frame_radius_factor),
           "the local frame uses the samples within this many support radii"),
     Param("weighted_frame", Range(0, 1), Only({kDld, kRld}),
-          OF(o.extractor.method == kRld ? o.extractor.rld.weighted_frame : o.extractor.dld.weighted_frame),
+          OF(kWeightedFrame.Of(o)),
           "distance-weighted (SHOT-style) PCA frame instead of plain PCA"),
     Param("rld_samples", Range(100, 10000000), Only({kRld}), OF(o.extractor.rld.num_samples),
           "resample points (N_RLD)"),
     Param("rld_neighbors", Range(1, 100), Only({kRld}), OF(o.extractor.rld.neighbors),
           "k of the k-nearest-neighbour graph"),
-    Param("levels", Range(2, 200), Only({kLd, kRld}), OF(ScaleSpace(o).levels),
+    Param("levels", Range(2, 200), Only({kLd, kRld}), OF(kScaleSpace.Of(o).levels),
           "scale-space levels L"),
-    Param("scale_factor", Range(1e-6, 1e6), Only({kLd, kRld}), OF(ScaleSpace(o).scale_factor),
+    Param("scale_factor", Range(1e-6, 1e6), Only({kLd, kRld}), OF(kScaleSpace.Of(o).scale_factor),
           "C in the feature scale s = C * d * sqrt(level)"),
     // Whole-model views (BF-DSIFT, LFD).
     Param("view_level", Range(0, 3), Only({kBf}), OF(o.extractor.bfdsift.view_level),
           "view directions: vertices of the icosahedron subdivided this often (1: 42)"),
     Param("view_size", Range(32, 1024), Only({kBf, kLfd}),
-          OF(o.extractor.method == kLfd ? o.extractor.lfd.image_size : o.extractor.bfdsift.view_size),
+          OF(kViewSize.Of(o)),
           "side of each whole-model view in pixels"),
     Param("contour_samples", Range(21, 65536), Only({kLfd}), OF(o.extractor.lfd.contour_samples),
           "points the silhouette's outer contour is resampled to (Fourier)"),
@@ -232,22 +251,34 @@ std::vector<ParamSpec> MakeTable() {
     Param("patch_scales", Range(1, 4), Only({kBf}), OF(o.extractor.bfdsift.patch_scales),
           "patch radii per point: patch_radius, twice it, ..."),
     // Depth images and their SIFT descriptors.
-    Param("image_size", Range(3, 255), kSiftMethods, OF(DepthImage(o).image_size),
+    Param("image_size", Range(3, 255), kSiftMethods, OF(kDepthImage.Of(o).image_size),
           "local depth image side I in pixels (odd)"),
     Param("orientation",
           Names<ImageOrientation>({{"dominant", ImageOrientation::kDominant},
                                    {"up", ImageOrientation::kUpAxis}}),
-          kSiftMethods, OF(Sift(o).orientation),
+          kSiftMethods, OF(kSift.Of(o).orientation),
           "descriptor rotation: Lowe's gradient peaks | PCA up axis + 180-degree sum"),
     Param("depth_to_gray",
           Names<DepthToGray>({{"fixed", DepthToGray::kFixedRange}, {"stretch", DepthToGray::kStretch}}),
-          kSiftMethods, OF(Sift(o).depth_to_gray),
+          kSiftMethods, OF(kSift.Of(o).depth_to_gray),
           "depth to grey: fixed (2s range) | stretch (image range)"),
-    Param("max_orientations", Range(0, 36), kSiftMethods, OF(Sift(o).max_orientations),
+    Param("max_orientations", Range(0, 36), kSiftMethods, OF(kSift.Of(o).max_orientations),
           "with dominant orientation: at most this many descriptors per image (0: every peak "
           "within 80 % of the highest)"),
-    Param("blur_sigma", Range(0.5, 5), kSiftMethods, OF(Sift(o).blur_sigma),
+    Param("blur_sigma", Range(0.5, 5), kSiftMethods, OF(kSift.Of(o).blur_sigma),
           "SIFT blur sigma in pixels"),
+  };
+  // clang-format on
+}
+
+// The rows of the codebook, the histograms' ranking and the collection's
+// fusion.
+std::vector<ParamSpec> RankingRows() {
+  using Assignment = KMeansOptions::Assignment;
+  using Rerank = RerankOptions::Method;
+  const double kMaxSeed = static_cast<double>(std::numeric_limits<uint64_t>::max());
+  // clang-format off
+  return {
     // The codebook and the histograms' ranking.
     Param("vocabulary", Range(1, kMaxVocabulary), kBagOfFeatures, OF(o.kmeans.num_centroids),
           "codebook size V (k-means centroids)"),
@@ -287,6 +318,12 @@ std::vector<ParamSpec> MakeTable() {
           "re-ranking: models re-ranked per query"),
   };
   // clang-format on
+}
+
+std::vector<ParamSpec> MakeTable() {
+  std::vector<ParamSpec> table = FeatureRows();
+  for (ParamSpec& row : RankingRows()) table.push_back(std::move(row));
+  return table;
 }
 
 #undef OF

@@ -44,6 +44,30 @@ absl::Status CheckQueryFlags(const v1::QueryRequest& request, const CollectionPl
   return absl::OkStatus();
 }
 
+// Features per model and part (the counts an eval prints), from the store.
+absl::StatusOr<std::map<std::string, std::vector<uint32_t>>> FeatureCounts(
+    CoordinatorStore& store, const CollectionPlan& plan) {
+  const std::size_t parts = plan.parts.size();
+  std::map<std::string, std::vector<uint32_t>> feature_counts;
+  for (std::size_t p = 0; p < parts; ++p) {
+    v1::ListCollectionModelsRequest list;
+    list.set_collection(plan.parts[p].name);
+    list.set_state(v1::MODEL_STATE_EXTRACTED);
+    list.set_page_size(1000);
+    do {
+      MESHSEEK_ASSIGN_OR_RETURN(const v1::ListCollectionModelsResponse page,
+                                store.ListModels(list));
+      for (const v1::ModelInfo& m : page.models()) {
+        std::vector<uint32_t>& counts = feature_counts[m.model_id()];
+        counts.resize(parts, 0);
+        counts[p] = m.features();
+      }
+      list.set_page_token(page.next_page_token());
+    } while (!list.page_token().empty());
+  }
+  return feature_counts;
+}
+
 }  // namespace
 
 absl::StatusOr<v1::Mesh> CoordinatorService::QueryMesh(const v1::QueryRequest& request,
@@ -189,25 +213,7 @@ absl::Status CoordinatorService::Evaluate(const v1::EvaluateRequest& request,
     absl::ReaderMutexLock lock(&loaded->mutex);
     ranking = loaded->ranking;
   }
-  // Feature counts per model and part.
-  const std::size_t parts = plan.parts.size();
-  std::map<std::string, std::vector<uint32_t>> feature_counts;
-  for (std::size_t p = 0; p < parts; ++p) {
-    v1::ListCollectionModelsRequest list;
-    list.set_collection(plan.parts[p].name);
-    list.set_state(v1::MODEL_STATE_EXTRACTED);
-    list.set_page_size(1000);
-    do {
-      MESHSEEK_ASSIGN_OR_RETURN(const v1::ListCollectionModelsResponse page,
-                                store_->ListModels(list));
-      for (const v1::ModelInfo& m : page.models()) {
-        std::vector<uint32_t>& counts = feature_counts[m.model_id()];
-        counts.resize(parts, 0);
-        counts[p] = m.features();
-      }
-      list.set_page_token(page.next_page_token());
-    } while (!list.page_token().empty());
-  }
+  MESHSEEK_ASSIGN_OR_RETURN(auto feature_counts, FeatureCounts(*store_, plan));
   v1::EvaluateRow out;
   uint64_t rows = 0;
   const absl::Status streamed = workers_.index()->ForEachDistanceRow(

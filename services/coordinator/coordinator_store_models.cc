@@ -333,6 +333,54 @@ absl::StatusOr<std::optional<ExtractedModel>> CoordinatorStore::LoadExtracted(
   return ExtractedRow(select);
 }
 
+namespace {
+
+// The state a listing keeps (-1: every state).
+absl::StatusOr<int64_t> StateFilter(v1::ModelState state) {
+  switch (state) {
+    case v1::MODEL_STATE_UNSPECIFIED:
+      return -1;
+    case v1::MODEL_STATE_PENDING:
+      return static_cast<int64_t>(ModelState::kPending);
+    case v1::MODEL_STATE_EXTRACTED:
+      return static_cast<int64_t>(ModelState::kExtracted);
+    case v1::MODEL_STATE_FAILED:
+      return static_cast<int64_t>(ModelState::kFailed);
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat("list models: unknown state ", static_cast<int>(state)));
+  }
+}
+
+// The listing's statement: ?1 collection, ?2 state (-1: any), ?3 the last
+// ordinal of the page before, ?4 rows; the members of a fused collection
+// follow as ?5...
+std::string ListModelsSql(std::size_t members, int64_t state) {
+  if (members > 0) {
+    // Each model once over the members, in the state CountModels gives it.
+    std::string in;
+    for (std::size_t i = 0; i < members; ++i) absl::StrAppend(&in, i ? ", ?" : "?", i + 5);
+    return absl::StrCat(
+        "SELECT model_id, MIN(label), CASE WHEN MAX(state = 2) THEN 2 WHEN MAX(state = 0) THEN 0 "
+        "ELSE 1 END AS merged, MIN(ordinal) AS first, MAX(attempts), GROUP_CONCAT(CASE WHEN "
+        "error != '' THEN substr(collection, instr(collection, '~') + 1) || ': ' || error END, "
+        "'; '), SUM(feature_count) FROM models WHERE collection IN (",
+        in,
+        ") GROUP BY model_id "
+        "HAVING (?2 < 0 OR merged = ?2) AND first > ?3 ORDER BY first LIMIT ?4");
+  }
+  // Two statements rather than "?2 < 0 OR state = ?2", so that each walks its
+  // index in order instead of sorting the collection.
+  return state < 0 ? "SELECT model_id, label, state, ordinal, attempts, error, feature_count "
+                     "FROM models WHERE collection = ?1 AND ?2 < 0 AND ordinal > ?3 "
+                     "ORDER BY ordinal LIMIT ?4"
+                   : "SELECT model_id, label, state, ordinal, attempts, error, feature_count "
+                     "FROM models WHERE collection = ?1 AND state = ?2 AND ordinal > ?3 "
+                     "ORDER BY ordinal LIMIT ?4";
+}
+
+}  // namespace
+
 absl::StatusOr<v1::ListCollectionModelsResponse> CoordinatorStore::ListModels(
     const v1::ListCollectionModelsRequest& request, const std::vector<std::string>& members) {
   const uint32_t page_size = request.page_size() == 0 ? kDefaultPageSize : request.page_size();
@@ -346,48 +394,9 @@ absl::StatusOr<v1::ListCollectionModelsResponse> CoordinatorStore::ListModels(
     return absl::InvalidArgumentError(
         absl::StrCat("list models: page_token '", request.page_token(), "' is not one we gave"));
   }
-  int64_t state = -1;
-  switch (request.state()) {
-    case v1::MODEL_STATE_UNSPECIFIED:
-      break;
-    case v1::MODEL_STATE_PENDING:
-      state = static_cast<int64_t>(ModelState::kPending);
-      break;
-    case v1::MODEL_STATE_EXTRACTED:
-      state = static_cast<int64_t>(ModelState::kExtracted);
-      break;
-    case v1::MODEL_STATE_FAILED:
-      state = static_cast<int64_t>(ModelState::kFailed);
-      break;
-    default:
-      return absl::InvalidArgumentError(
-          absl::StrCat("list models: unknown state ", static_cast<int>(request.state())));
-  }
+  MESHSEEK_ASSIGN_OR_RETURN(const int64_t state, StateFilter(request.state()));
   absl::MutexLock lock(&mutex_);
-  std::string sql;
-  if (!members.empty()) {
-    // Each model once over the members, in the state CountModels gives it.
-    std::string in;
-    for (std::size_t i = 0; i < members.size(); ++i) absl::StrAppend(&in, i ? ", ?" : "?", i + 5);
-    sql = absl::StrCat(
-        "SELECT model_id, MIN(label), CASE WHEN MAX(state = 2) THEN 2 WHEN MAX(state = 0) THEN 0 "
-        "ELSE 1 END AS merged, MIN(ordinal) AS first, MAX(attempts), GROUP_CONCAT(CASE WHEN "
-        "error != '' THEN substr(collection, instr(collection, '~') + 1) || ': ' || error END, "
-        "'; '), SUM(feature_count) FROM models WHERE collection IN (",
-        in,
-        ") GROUP BY model_id "
-        "HAVING (?2 < 0 OR merged = ?2) AND first > ?3 ORDER BY first LIMIT ?4");
-  } else {
-    // Two statements rather than "?2 < 0 OR state = ?2", so that each walks
-    // its index in order instead of sorting the collection.
-    sql = state < 0 ? "SELECT model_id, label, state, ordinal, attempts, error, "
-                      "feature_count FROM models WHERE collection = ?1 AND ?2 < "
-                      "0 AND ordinal > ?3 ORDER BY ordinal LIMIT ?4"
-                    : "SELECT model_id, label, state, ordinal, attempts, error, "
-                      "feature_count FROM models WHERE collection = ?1 AND "
-                      "state = ?2 AND ordinal > ?3 ORDER BY ordinal LIMIT ?4";
-  }
-  MESHSEEK_ASSIGN_OR_RETURN(Statement select, db_->Prepare(sql));
+  MESHSEEK_ASSIGN_OR_RETURN(Statement select, db_->Prepare(ListModelsSql(members.size(), state)));
   select.Bind(1, request.collection())
       .Bind(2, state)
       .Bind(3, after)

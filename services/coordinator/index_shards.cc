@@ -214,6 +214,79 @@ absl::StatusOr<IndexShards::PartModels> IndexShards::ExportParts(const std::vect
   return out;
 }
 
+absl::Status IndexShards::DistanceBlock(const Part& part,
+                                        const std::vector<std::string>& ids,
+                                        const absl::flat_hash_map<std::string, std::size_t>& column,
+                                        std::vector<float>* block) {
+  v1::DistancesRequest request;
+  request.set_collection(part.collection);
+  request.set_kl_epsilon(part.kl_epsilon);
+  // The block's signatures, a block at a time: a large collection's
+  // histograms never sit in the coordinator's memory at once.
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<v1::IndexedModel> block_models,
+                            Fetch(part, ids));
+  for (const v1::IndexedModel& m : block_models) {
+    if (m.has_global_descriptor()) {
+      *request.add_global_queries() = m.global_descriptor();
+    } else {
+      *request.add_queries() = m.histogram();
+    }
+  }
+  const std::size_t n = column.size();
+  const std::size_t queries = ids.size();
+  block->assign(queries * n, -1.0f);
+  std::size_t covered = 0;
+  for (std::size_t s = 0; s < shards_.size(); ++s) {
+    v1::DistancesResponse response;
+    const absl::Status status = rpc::CallWithRetry(shards_[s].get(),
+                                                   &v1::Index::Stub::Distances,
+                                                   request,
+                                                   &response,
+                                                   call_deadline_,
+                                                   retry_,
+                                                   stop_);
+    if (status.code() == absl::StatusCode::kNotFound) continue;
+    if (!status.ok()) {
+      return absl::Status(status.code(),
+                          absl::StrCat("index shard ", s, ": ", status.message()));
+    }
+    const std::size_t m = static_cast<std::size_t>(response.model_ids_size());
+    if (static_cast<std::size_t>(response.distances_size()) != queries * m) {
+      return absl::InternalError(absl::StrCat("index shard ",
+                                              s,
+                                              " answered ",
+                                              response.distances_size(),
+                                              " distances for ",
+                                              queries,
+                                              " queries and ",
+                                              m,
+                                              " models"));
+    }
+    for (std::size_t j = 0; j < m; ++j) {
+      auto it = column.find(response.model_ids(static_cast<int>(j)));
+      // A model added after the export has no row: it waits for the
+      // next evaluation.
+      if (it == column.end()) continue;
+      ++covered;
+      for (std::size_t q = 0; q < queries; ++q) {
+        (*block)[q * n + it->second] = response.distances(static_cast<int>(q * m + j));
+      }
+    }
+  }
+  if (covered != n) {
+    // A model removed (or a shard emptied) between the export and now.
+    return absl::AbortedError(absl::StrCat("collection '",
+                                           part.collection,
+                                           "' changed while its distance matrix was ",
+                                           "assembled (",
+                                           covered,
+                                           " of ",
+                                           n,
+                                           " models answered); try again"));
+  }
+  return absl::OkStatus();
+}
+
 absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
                                              const std::function<absl::Status(const Row&)>& fn,
                                              const std::vector<std::size_t>* only_rows) {
@@ -244,71 +317,7 @@ absl::Status IndexShards::ForEachDistanceRow(const std::vector<Part>& parts,
     std::vector<std::string> ids;
     for (std::size_t r = begin; r < end; ++r) ids.push_back(models[0][rows[r]].model_id());
     for (std::size_t p = 0; p < p_count; ++p) {
-      v1::DistancesRequest request;
-      request.set_collection(parts[p].collection);
-      request.set_kl_epsilon(parts[p].kl_epsilon);
-      // The block's signatures, a block at a time: a large collection's
-      // histograms never sit in the coordinator's memory at once.
-      MESHSEEK_ASSIGN_OR_RETURN(const std::vector<v1::IndexedModel> block_models,
-                                Fetch(parts[p], ids));
-      for (const v1::IndexedModel& m : block_models) {
-        if (m.has_global_descriptor()) {
-          *request.add_global_queries() = m.global_descriptor();
-        } else {
-          *request.add_queries() = m.histogram();
-        }
-      }
-      std::vector<float>& block = blocks[p];
-      block.assign((end - begin) * n, -1.0f);
-      std::size_t covered = 0;
-      for (std::size_t s = 0; s < shards_.size(); ++s) {
-        v1::DistancesResponse response;
-        const absl::Status status = rpc::CallWithRetry(shards_[s].get(),
-                                                       &v1::Index::Stub::Distances,
-                                                       request,
-                                                       &response,
-                                                       call_deadline_,
-                                                       retry_,
-                                                       stop_);
-        if (status.code() == absl::StatusCode::kNotFound) continue;
-        if (!status.ok()) {
-          return absl::Status(status.code(),
-                              absl::StrCat("index shard ", s, ": ", status.message()));
-        }
-        const std::size_t m = static_cast<std::size_t>(response.model_ids_size());
-        if (static_cast<std::size_t>(response.distances_size()) != (end - begin) * m) {
-          return absl::InternalError(absl::StrCat("index shard ",
-                                                  s,
-                                                  " answered ",
-                                                  response.distances_size(),
-                                                  " distances for ",
-                                                  end - begin,
-                                                  " queries and ",
-                                                  m,
-                                                  " models"));
-        }
-        for (std::size_t j = 0; j < m; ++j) {
-          auto it = column.find(response.model_ids(static_cast<int>(j)));
-          // A model added after the export has no row: it waits for the
-          // next evaluation.
-          if (it == column.end()) continue;
-          ++covered;
-          for (std::size_t q = 0; q < end - begin; ++q) {
-            block[q * n + it->second] = response.distances(static_cast<int>(q * m + j));
-          }
-        }
-      }
-      if (covered != n) {
-        // A model removed (or a shard emptied) between the export and now.
-        return absl::AbortedError(absl::StrCat("collection '",
-                                               parts[p].collection,
-                                               "' changed while its distance matrix was ",
-                                               "assembled (",
-                                               covered,
-                                               " of ",
-                                               n,
-                                               " models answered); try again"));
-      }
+      MESHSEEK_RETURN_IF_ERROR(DistanceBlock(parts[p], ids, column, &blocks[p]));
     }
     for (std::size_t r = begin; r < end; ++r) {
       const std::size_t i = rows[r];

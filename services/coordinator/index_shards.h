@@ -132,6 +132,13 @@ class IndexShards {
   // from its shard; Aborted for one no longer there.
   absl::StatusOr<std::vector<v1::IndexedModel>> Fetch(const Part& part,
                                                       const std::vector<std::string>& model_ids);
+  // The distances from the models `ids` of `part` to every model of it, a
+  // row of n per id in `column`'s order (`column`: model id -> column), from
+  // every shard; Aborted when the part's models changed since `column`.
+  absl::Status DistanceBlock(const Part& part,
+                             const std::vector<std::string>& ids,
+                             const absl::flat_hash_map<std::string, std::size_t>& column,
+                             std::vector<float>* block);
   // The queries of `model_ids` as shard s takes them: by id where it holds
   // them, whole (from their shards) where it does not.
   absl::StatusOr<std::vector<std::vector<v1::QueryModel>>> QueriesPerShard(
