@@ -31,10 +31,7 @@ absl::StatusOr<std::vector<ModelToIngest>> ModelsToIngest(const CliFlags& flags)
   const std::string& folder = flags.folder;
   if (!manifest.empty()) {
     MESHSEEK_ASSIGN_OR_RETURN(const std::vector<ManifestEntry> entries, ReadManifest(manifest));
-    for (const ManifestEntry& e : entries) {
-      models.push_back({e.id, e.label, e.path,
-                        absl::StrCat("model '", e.id, "' (manifest line ", e.line, ")")});
-    }
+    models = ModelsOfManifest(entries);
   } else if (!folder.empty()) {
     std::error_code error;
     std::vector<std::filesystem::path> files;

@@ -15,6 +15,15 @@
 
 namespace meshseek::cli {
 
+std::vector<ModelToIngest> ModelsOfManifest(const std::vector<ManifestEntry>& entries) {
+  std::vector<ModelToIngest> models;
+  for (const ManifestEntry& e : entries) {
+    models.push_back(
+        {e.id, e.label, e.path, absl::StrCat("model '", e.id, "' (manifest line ", e.line, ")")});
+  }
+  return models;
+}
+
 absl::StatusOr<std::unique_ptr<CoordinatorClient>> CoordinatorClient::Open(
     const ClientOptions& options) {
   std::unique_ptr<CoordinatorClient> client(new CoordinatorClient());

@@ -15,6 +15,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "common/eval/manifest.h"
 #include "common/flags/pipeline_flags.h"
 #include "common/geometry/mesh_io.h"
 #include "common/rpc/client.h"
@@ -50,6 +51,9 @@ struct ModelToIngest {
   std::string path;
   std::string where;
 };
+
+/// The models of a manifest, each named by its id and line.
+std::vector<ModelToIngest> ModelsOfManifest(const std::vector<ManifestEntry>& entries);
 
 class CoordinatorClient {
  public:

@@ -118,12 +118,7 @@ absl::StatusOr<CollectionEvaluation> EvaluateThroughServices(const CliFlags& fla
   const std::string collection =
       flags.collection.empty() ? EvalCollectionName(*options, flags.manifest) : flags.collection;
   MESHSEEK_RETURN_IF_ERROR(client->EnsureCollection(collection, flags.params));
-  std::vector<ModelToIngest> to_ingest;
-  for (const ManifestEntry& e : models) {
-    to_ingest.push_back(
-        {e.id, e.label, e.path, absl::StrCat("model '", e.id, "' (manifest line ", e.line, ")")});
-  }
-  MESHSEEK_RETURN_IF_ERROR(client->Ingest(collection, to_ingest));
+  MESHSEEK_RETURN_IF_ERROR(client->Ingest(collection, ModelsOfManifest(models)));
   CollectionEvaluation evaluation;
   evaluation.timings.extract_seconds = absl::ToDoubleSeconds(absl::Now() - start);
   MESHSEEK_ASSIGN_OR_RETURN(const v1::Collection info, client->GetCollection(collection));

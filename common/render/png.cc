@@ -2,7 +2,6 @@
 
 #include <png.h>
 
-#include <cstdio>
 #include <cstring>
 #include <optional>
 
