@@ -110,7 +110,8 @@ EVAL=$!
 sleep 3
 $COMPOSE up -d --no-recreate --scale extract=3 > "$T/compose.log" 2>&1 || { cat "$T/compose.log"; fail "scale to 3"; }
 sleep 4
-victim=$($COMPOSE ps -q extract 2>/dev/null | head -1)
+# awk, not head: under pipefail, head's early exit may end compose by SIGPIPE (exit 141).
+victim=$($COMPOSE ps -q extract 2>/dev/null | awk 'NR == 1')
 docker kill --signal KILL "$victim" >/dev/null
 step "killed extract container ${victim:0:12}"
 wait "$EVAL" || { cat "$T/cluster.log"; fail "eval through the cluster failed"; }
@@ -147,7 +148,8 @@ curl -sf "http://$ip:9464/metrics" | grep '^meshseek_coordinator_models{collecti
 step "the query page (web service, port $MESHSEEK_WEB_PORT)"
 web=http://localhost:$MESHSEEK_WEB_PORT
 for _ in $(seq 50); do curl -sf "$web/" >/dev/null && break; sleep 0.2; done
-curl -sf "$web/" | grep -q 'id="results"' || fail "no query page at $web/"
+curl -sf "$web/" -o "$T/page.html" && grep -q 'id="results"' "$T/page.html" \
+  || fail "no query page at $web/"
 curl -sf "$web/api/collections" | python3 -c 'import json, sys
 sys.exit(0 if any(c["name"] == "synthetic" for c in json.load(sys.stdin)["collections"]) else 1)' \
   || fail "web lists no collection 'synthetic'"
@@ -158,8 +160,8 @@ answer=$(curl -sf -F collection=synthetic -F top_k=3 -F "mesh=@$T/syn/$query" "$
 echo "$answer" | python3 -c 'import json, sys
 sys.exit(0 if json.load(sys.stdin)["results"][0]["model_id"] == sys.argv[1] else 1)' "$query_id" \
   || fail "web: $query_id not first: $answer"
-curl -sf "$web/api/thumbnail?collection=synthetic&model_id=$query_id" | head -c 4 | grep -q PNG \
-  || fail "web: no thumbnail"
+curl -sf "$web/api/thumbnail?collection=synthetic&model_id=$query_id" -o "$T/thumb.png" \
+  && [ "$(head -c 4 "$T/thumb.png" | tail -c 3)" = PNG ] || fail "web: no thumbnail"
 step "  uploaded $query: first result $query_id, thumbnail served"
 
 step "down and up again: the index is still there"
