@@ -3,7 +3,7 @@
 // (histogram_embedding.h, what KlInvertedIndex::Search does with candidates)
 // against Faiss' exact batched search (IndexFlatL2: a matrix product on BLAS),
 // HNSW (IndexHNSWFlat) and IVF (IndexIVFFlat) over the same embeddings, on
-// synthetic histograms of one member's shape (bench/synthetic_histograms.h):
+// synthetic histograms of one member's shape (common/search/synthetic_histograms.h):
 //
 //   candidate_search --models 10000 [--vocabulary 2000] [--descriptors 3791]
 //     [--candidates 50] [--queries 200] [--hnsw_m 32] [--threads 2]
@@ -34,7 +34,7 @@
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
-#include "bench/synthetic_histograms.h"
+#include "common/search/synthetic_histograms.h"
 #include "common/base/parallel.h"
 #include "common/search/histogram_embedding.h"
 #include "common/search/kl_inverted_index.h"
@@ -43,7 +43,7 @@ ABSL_FLAG(int, models, 10000, "models in the collection");
 ABSL_FLAG(int, vocabulary, 2000, "words (RLD-SIFT and LSF: 2,000; BF-DSIFT: 40,000)");
 ABSL_FLAG(int, descriptors, 3791, "local features a model (RLD-SIFT's McGill median)");
 ABSL_FLAG(int, centres, 4,
-          "centres a model's words are drawn around (1: bench/synthetic_histograms.h's models, "
+          "centres a model's words are drawn around (1: common/search/synthetic_histograms.h's models, "
           "which lie near a curve, too easy for any index)");
 ABSL_FLAG(int, candidates, 50, "C, candidates a model");
 ABSL_FLAG(int, queries, 200, "stored models whose exact 10 nearest the recall is measured on");

@@ -35,7 +35,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
-#include "bench/synthetic_histograms.h"
+#include "common/search/synthetic_histograms.h"
 #include "common/rpc/client.h"
 #include "common/rpc/free_port.h"
 #include "common/wire/convert.h"

@@ -11,7 +11,7 @@ ARGS=(--query_clients 64 --ingest_clients 4 --duration 60s --models_per_class 8 
 {
   echo "# bench/load.sh $(date -u '+%F %H:%M') UTC, $(nproc) cores:$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), $(free -g | awk '/Mem:/ {print $2}') GiB"
   echo "# load: $(uptime | sed 's/.*load average/load average/') before the run (the machine may be shared)"
-  echo "# command: build/bench/load_benchmark ${ARGS[*]}"
+  echo "# command: build/services/load_benchmark ${ARGS[*]}"
   echo "# embedded stack, shipped defaults (method dld; server threads 16, queue 256 per service)"
 } > "$RESULT"
-build/bench/load_benchmark "${ARGS[@]}" 2>/dev/null | tee -a "$RESULT"
+build/services/load_benchmark "${ARGS[@]}" 2>/dev/null | tee -a "$RESULT"

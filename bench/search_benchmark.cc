@@ -14,7 +14,7 @@
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
-#include "bench/synthetic_histograms.h"
+#include "common/search/synthetic_histograms.h"
 #include "common/search/kl_inverted_index.h"
 
 ABSL_FLAG(int, models, 100000, "models in the index");

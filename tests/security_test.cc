@@ -26,7 +26,7 @@
 #include "gtest/gtest.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"
 #include "meshseek/v1/index.grpc.pb.h"
-#include "services/index/index_service.h"
+#include "services/index/index_grpc.h"
 
 namespace meshseek {
 namespace {
@@ -186,7 +186,8 @@ TEST_F(SecurityTest, ServiceWithMutualTlsRefusesStrangersAndPlaintext) {
   options.address = "127.0.0.1:0";
   options.health_address = "127.0.0.1:0";
   options.security.tls = Tls("ca");
-  auto server = rpc::RpcServer::Start("index", {index->get()}, options);
+  IndexGrpc grpc(index->get());
+  auto server = rpc::RpcServer::Start("index", {&grpc}, options);
   ASSERT_TRUE(server.ok()) << server.status();
   const int port = (*server)->port();
 

@@ -6,10 +6,12 @@
 //   client stream  absl::StatusOr<Response> Method(Reader<Request>, const CallContext&)
 //   bidirectional  absl::Status Method(Reader<Request>, Writer<Response>, const CallContext&)
 //
-// and the service's gRPC entry point (the generated virtual method, of the
-// same name) is one call of Serve below with the handler's address, which turns the handler's absl::Status into the
-// grpc::Status with the same canonical code and message (status.h), fills the
-// response, and gives the handler the call's deadline and cancellation. What
+// The service class knows nothing of gRPC: its binding (services/NAME/NAME_grpc.h,
+// deriving from the generated v1::NAME::Service) overrides each generated entry
+// point with one call of Serve below and the handler's address. Serve turns the
+// handler's absl::Status into the grpc::Status with the same canonical code and
+// message (status.h), fills the response, and gives the handler the call's
+// deadline and cancellation. What
 // every call also gets (counting and timing by method and code, admission,
 // message limits) is the server's (server.h), so no handler repeats it.
 #ifndef MESHSEEK_COMMON_RPC_HANDLER_H_

@@ -18,7 +18,7 @@
 #include "common/bof/codebook.h"
 #include "common/rpc/handler.h"
 #include "common/store/sqlite_db.h"
-#include "meshseek/v1/codebook.grpc.pb.h"
+#include "meshseek/v1/codebook.pb.h"
 
 namespace meshseek {
 
@@ -32,7 +32,7 @@ struct CodebookServiceOptions {
   absl::Status Validate() const;
 };
 
-class CodebookService final : public v1::Codebook::Service {
+class CodebookService final {
  public:
   static absl::StatusOr<std::unique_ptr<CodebookService>> Create(
       const CodebookServiceOptions& options);
@@ -43,23 +43,6 @@ class CodebookService final : public v1::Codebook::Service {
                                             const rpc::CallContext& call);
   absl::StatusOr<v1::CodebookInfo> GetCodebook(const v1::GetCodebookRequest& request,
                                                const rpc::CallContext& call);
-
-  // gRPC entry points (common/rpc/handler.h).
-  grpc::Status Train(grpc::ServerContext* context,
-                     grpc::ServerReader<v1::TrainCodebookRequest>* reader,
-                     v1::CodebookInfo* response) override {
-    return rpc::Serve(context, reader, response, this, &CodebookService::Train);
-  }
-  grpc::Status Encode(grpc::ServerContext* context,
-                      const v1::EncodeRequest* request,
-                      v1::EncodeResponse* response) override {
-    return rpc::Serve(context, request, response, this, &CodebookService::Encode);
-  }
-  grpc::Status GetCodebook(grpc::ServerContext* context,
-                           const v1::GetCodebookRequest* request,
-                           v1::CodebookInfo* response) override {
-    return rpc::Serve(context, request, response, this, &CodebookService::GetCodebook);
-  }
 
  private:
   struct Entry {

@@ -4,7 +4,7 @@
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
 #include "common/rpc/server_main.h"
-#include "services/codebook/codebook_service.h"
+#include "services/codebook/codebook_grpc.h"
 
 ABSL_FLAG(std::string, data_dir, "", "folder of the codebook database (required)");
 ABSL_FLAG(int, threads, 0, "threads for k-means and encoding (0: all cores)");
@@ -18,5 +18,6 @@ int main(int argc, char** argv) {
   options.num_threads = absl::GetFlag(FLAGS_threads);
   auto service = meshseek::CodebookService::Create(options);
   if (!service.ok()) return meshseek::rpc::ExitWithError("codebook", service.status());
-  return meshseek::rpc::ServeUntilSignal("codebook", {service->get()});
+  meshseek::CodebookGrpc grpc(service->get());
+  return meshseek::rpc::ServeUntilSignal("codebook", {&grpc});
 }

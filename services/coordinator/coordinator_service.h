@@ -48,7 +48,7 @@
 #include "absl/synchronization/mutex.h"
 #include "common/rpc/handler.h"
 #include "common/rpc/metrics.h"
-#include "meshseek/v1/coordinator.grpc.pb.h"
+#include "meshseek/v1/coordinator.pb.h"
 #include "services/coordinator/build_runner.h"
 #include "services/coordinator/coordinator_options.h"
 #include "services/coordinator/coordinator_store.h"
@@ -59,11 +59,11 @@
 
 namespace meshseek {
 
-class CoordinatorService final : public v1::Coordinator::Service {
+class CoordinatorService final {
  public:
   static absl::StatusOr<std::unique_ptr<CoordinatorService>> Create(
       const CoordinatorOptions& options);
-  ~CoordinatorService() override;
+  ~CoordinatorService();
 
   /// Stops the dispatchers and build jobs (after the server has shut down).
   void Stop();
@@ -80,49 +80,6 @@ class CoordinatorService final : public v1::Coordinator::Service {
   absl::StatusOr<v1::ListCollectionsResponse> ListCollections(const v1::ListCollectionsRequest& request, const rpc::CallContext& call);
   absl::StatusOr<v1::Thumbnail> GetThumbnail(const v1::GetThumbnailRequest& request, const rpc::CallContext& call);
   absl::Status Evaluate(const v1::EvaluateRequest& request, rpc::Writer<v1::EvaluateRow> write, const rpc::CallContext& call);
-
-  // gRPC entry points (common/rpc/handler.h).
-  grpc::Status CreateCollection(grpc::ServerContext* context, const v1::CreateCollectionRequest* request, v1::Collection* response) override {
-    return rpc::Serve(context, request, response, this, &CoordinatorService::CreateCollection);
-  }
-  grpc::Status GetCollection(grpc::ServerContext* context, const v1::GetCollectionRequest* request, v1::Collection* response) override {
-    return rpc::Serve(context, request, response, this, &CoordinatorService::GetCollection);
-  }
-  grpc::Status Ingest(grpc::ServerContext* context,
-                      grpc::ServerReaderWriter<v1::IngestAck, v1::IngestRequest>* stream) override {
-    return rpc::Serve(context, stream, this, &CoordinatorService::Ingest);
-  }
-  grpc::Status Build(grpc::ServerContext* context, const v1::BuildRequest* request, v1::JobStatus* response) override {
-    return rpc::Serve(context, request, response, this, &CoordinatorService::Build);
-  }
-  grpc::Status GetJob(grpc::ServerContext* context, const v1::JobRequest* request, v1::JobStatus* response) override {
-    return rpc::Serve(context, request, response, this, &CoordinatorService::GetJob);
-  }
-  grpc::Status WatchJob(grpc::ServerContext* context,
-                      const v1::JobRequest* request,
-                      grpc::ServerWriter<v1::JobStatus>* writer) override {
-    return rpc::Serve(context, request, writer, this, &CoordinatorService::WatchJob);
-  }
-  grpc::Status Query(grpc::ServerContext* context, const v1::QueryRequest* request, v1::QueryResponse* response) override {
-    return rpc::Serve(context, request, response, this, &CoordinatorService::Query);
-  }
-  grpc::Status RemoveModel(grpc::ServerContext* context, const v1::RemoveModelFromCollectionRequest* request, v1::RemoveModelFromCollectionResponse* response) override {
-    return rpc::Serve(context, request, response, this, &CoordinatorService::RemoveModel);
-  }
-  grpc::Status ListModels(grpc::ServerContext* context, const v1::ListCollectionModelsRequest* request, v1::ListCollectionModelsResponse* response) override {
-    return rpc::Serve(context, request, response, this, &CoordinatorService::ListModels);
-  }
-  grpc::Status ListCollections(grpc::ServerContext* context, const v1::ListCollectionsRequest* request, v1::ListCollectionsResponse* response) override {
-    return rpc::Serve(context, request, response, this, &CoordinatorService::ListCollections);
-  }
-  grpc::Status GetThumbnail(grpc::ServerContext* context, const v1::GetThumbnailRequest* request, v1::Thumbnail* response) override {
-    return rpc::Serve(context, request, response, this, &CoordinatorService::GetThumbnail);
-  }
-  grpc::Status Evaluate(grpc::ServerContext* context,
-                      const v1::EvaluateRequest* request,
-                      grpc::ServerWriter<v1::EvaluateRow>* writer) override {
-    return rpc::Serve(context, request, writer, this, &CoordinatorService::Evaluate);
-  }
 
  private:
   CoordinatorService(const CoordinatorOptions& options, std::unique_ptr<CoordinatorStore> store);

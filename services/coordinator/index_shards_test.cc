@@ -14,7 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "gtest/gtest.h"
 #include "common/rpc/server.h"
-#include "services/index/index_service.h"
+#include "services/index/index_grpc.h"
 
 namespace meshseek {
 namespace {
@@ -24,6 +24,7 @@ constexpr std::size_t kModels = 120;
 
 struct IndexServer {
   std::unique_ptr<IndexService> service;
+  std::unique_ptr<IndexGrpc> grpc;
   std::unique_ptr<rpc::RpcServer> server;
 };
 
@@ -32,7 +33,8 @@ IndexServer StartIndex(const std::string& dir) {
   index.service = *IndexService::Create({dir, 1});
   rpc::ServerOptions options;
   options.address = "127.0.0.1:0";
-  index.server = *rpc::RpcServer::Start("index", {index.service.get()}, options);
+  index.grpc = std::make_unique<IndexGrpc>(index.service.get());
+  index.server = *rpc::RpcServer::Start("index", {index.grpc.get()}, options);
   return index;
 }
 

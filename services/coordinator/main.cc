@@ -13,7 +13,7 @@
 #include "common/rpc/credentials.h"
 #include "common/flags/mesh_limit_flags.h"
 #include "common/rpc/server_main.h"
-#include "services/coordinator/coordinator_service.h"
+#include "services/coordinator/coordinator_grpc.h"
 
 namespace {
 const meshseek::CoordinatorOptions kDefaults;
@@ -105,6 +105,7 @@ int main(int argc, char** argv) {
   auto service = meshseek::CoordinatorService::Create(options);
   if (!service.ok()) return meshseek::rpc::ExitWithError("coordinator", service.status());
   meshseek::CoordinatorService* coordinator = service->get();
-  return meshseek::rpc::ServeUntilSignal("coordinator", {coordinator}, *server,
+  meshseek::CoordinatorGrpc grpc(coordinator);
+  return meshseek::rpc::ServeUntilSignal("coordinator", {&grpc}, *server,
                                          [coordinator] { coordinator->Stop(); });
 }

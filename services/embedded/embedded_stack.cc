@@ -3,6 +3,11 @@
 #include "absl/strings/str_cat.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
+#include "services/codebook/codebook_grpc.h"
+#include "services/coordinator/coordinator_grpc.h"
+#include "services/extract/extract_grpc.h"
+#include "services/index/index_grpc.h"
+#include "services/resample/resample_grpc.h"
 
 namespace meshseek {
 
@@ -19,8 +24,11 @@ absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(
   server.address = "127.0.0.1:0";
   server.grace_period = absl::Seconds(2);
   server.security.tls = security.internal;
-  auto serve = [&](const char* name, grpc::Service* service) -> absl::StatusOr<std::string> {
-    MESHSEEK_ASSIGN_OR_RETURN(auto started, rpc::RpcServer::Start(name, {service}, server));
+  auto serve = [&](const char* name,
+                   std::unique_ptr<grpc::Service> binding) -> absl::StatusOr<std::string> {
+    stack->bindings_.push_back(std::move(binding));
+    MESHSEEK_ASSIGN_OR_RETURN(auto started,
+                              rpc::RpcServer::Start(name, {stack->bindings_.back().get()}, server));
     const std::string address = absl::StrCat("127.0.0.1:", started->port());
     stack->servers_.push_back(std::move(started));
     return address;
@@ -37,10 +45,18 @@ absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(
 
   CoordinatorOptions coordinator;
   coordinator.data_dir = data_dir + "/coordinator";
-  MESHSEEK_ASSIGN_OR_RETURN(coordinator.resample_target, serve("resample", stack->resample_.get()));
-  MESHSEEK_ASSIGN_OR_RETURN(coordinator.extract_target, serve("extract", stack->extract_.get()));
-  MESHSEEK_ASSIGN_OR_RETURN(coordinator.codebook_target, serve("codebook", stack->codebook_.get()));
-  MESHSEEK_ASSIGN_OR_RETURN(coordinator.index_target, serve("index", stack->index_.get()));
+  MESHSEEK_ASSIGN_OR_RETURN(
+      coordinator.resample_target,
+      serve("resample", std::make_unique<ResampleGrpc>(stack->resample_.get())));
+  MESHSEEK_ASSIGN_OR_RETURN(
+      coordinator.extract_target,
+      serve("extract", std::make_unique<ExtractGrpc>(stack->extract_.get())));
+  MESHSEEK_ASSIGN_OR_RETURN(
+      coordinator.codebook_target,
+      serve("codebook", std::make_unique<CodebookGrpc>(stack->codebook_.get())));
+  MESHSEEK_ASSIGN_OR_RETURN(
+      coordinator.index_target,
+      serve("index", std::make_unique<IndexGrpc>(stack->index_.get())));
   coordinator.max_in_flight = cores;
   coordinator.mesh_limits = mesh_limits;
   rpc::ClientSecurityOptions outbound;
@@ -52,8 +68,9 @@ absl::StatusOr<std::unique_ptr<EmbeddedStack>> EmbeddedStack::Start(
   // The process has one registry: the endpoint on the coordinator's server
   // serves the other four's calls as well.
   if (metrics_port != 0) server.metrics_address = absl::StrCat("127.0.0.1:", metrics_port);
-  MESHSEEK_ASSIGN_OR_RETURN(stack->coordinator_address_,
-                            serve("coordinator", stack->coordinator_.get()));
+  MESHSEEK_ASSIGN_OR_RETURN(
+      stack->coordinator_address_,
+      serve("coordinator", std::make_unique<CoordinatorGrpc>(stack->coordinator_.get())));
   return stack;
 }
 

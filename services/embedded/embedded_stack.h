@@ -58,6 +58,8 @@ class EmbeddedStack {
   std::unique_ptr<CodebookService> codebook_;
   std::unique_ptr<IndexService> index_;
   std::unique_ptr<CoordinatorService> coordinator_;
+  // Each service's gRPC entry points (services/*/*_grpc.h); outlive the servers.
+  std::vector<std::unique_ptr<grpc::Service>> bindings_;
   std::vector<std::unique_ptr<rpc::RpcServer>> servers_;  // coordinator last
   std::string coordinator_address_;
 };

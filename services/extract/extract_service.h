@@ -12,7 +12,7 @@
 #include "absl/synchronization/mutex.h"
 #include "common/geometry/mesh_io.h"
 #include "common/rpc/handler.h"
-#include "meshseek/v1/extract.grpc.pb.h"
+#include "meshseek/v1/extract.pb.h"
 
 namespace meshseek {
 
@@ -25,19 +25,12 @@ struct ExtractServiceOptions {
   absl::Status Validate() const;
 };
 
-class ExtractService final : public v1::Extract::Service {
+class ExtractService final {
  public:
   explicit ExtractService(const ExtractServiceOptions& options);
 
   absl::StatusOr<v1::ExtractResponse> Extract(const v1::ExtractRequest& request,
                                               const rpc::CallContext& call);
-
-  // gRPC entry point (common/rpc/handler.h).
-  grpc::Status Extract(grpc::ServerContext* context,
-                       const v1::ExtractRequest* request,
-                       v1::ExtractResponse* response) override {
-    return rpc::Serve(context, request, response, this, &ExtractService::Extract);
-  }
 
  private:
   const int workers_;

@@ -6,7 +6,7 @@
 #include "absl/flags/usage.h"
 #include "common/flags/mesh_limit_flags.h"
 #include "common/rpc/server_main.h"
-#include "services/extract/extract_service.h"
+#include "services/extract/extract_grpc.h"
 
 ABSL_FLAG(int, workers, 0, "concurrent extractions (0: one per core)");
 
@@ -23,5 +23,6 @@ int main(int argc, char** argv) {
     return meshseek::rpc::ExitWithError("extract", valid);
   }
   meshseek::ExtractService service(options);
-  return meshseek::rpc::ServeUntilSignal("extract", {&service});
+  meshseek::ExtractGrpc grpc(&service);
+  return meshseek::rpc::ServeUntilSignal("extract", {&grpc});
 }

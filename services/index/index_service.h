@@ -30,7 +30,7 @@
 #include "absl/synchronization/mutex.h"
 #include "common/rpc/handler.h"
 #include "common/rpc/metrics.h"
-#include "meshseek/v1/index.grpc.pb.h"
+#include "meshseek/v1/index.pb.h"
 #include "services/index/index_collection.h"
 #include "services/index/index_store.h"
 
@@ -52,7 +52,7 @@ struct IndexServiceOptions {
   absl::Status Validate() const;
 };
 
-class IndexService final : public v1::Index::Service {
+class IndexService final {
  public:
   /// Most query histograms in one Distances request.
   static constexpr int kMaxDistanceQueries = 4096;
@@ -87,48 +87,6 @@ class IndexService final : public v1::Index::Service {
                          const rpc::CallContext& call);
   absl::StatusOr<v1::PairDistancesResponse> PairDistances(const v1::PairDistancesRequest& request,
                                                           const rpc::CallContext& call);
-
-  // gRPC entry points (common/rpc/handler.h).
-  grpc::Status AddModel(grpc::ServerContext* context,
-                        const v1::AddModelRequest* request,
-                        v1::AddModelResponse* response) override {
-    return rpc::Serve(context, request, response, this, &IndexService::AddModel);
-  }
-  grpc::Status RemoveModel(grpc::ServerContext* context,
-                           const v1::RemoveModelRequest* request,
-                           v1::RemoveModelResponse* response) override {
-    return rpc::Serve(context, request, response, this, &IndexService::RemoveModel);
-  }
-  grpc::Status Search(grpc::ServerContext* context,
-                      const v1::SearchRequest* request,
-                      v1::SearchResponse* response) override {
-    return rpc::Serve(context, request, response, this, &IndexService::Search);
-  }
-  grpc::Status ExportModels(grpc::ServerContext* context,
-                            const v1::ExportModelsRequest* request,
-                            grpc::ServerWriter<v1::IndexedModel>* writer) override {
-    return rpc::Serve(context, request, writer, this, &IndexService::ExportModels);
-  }
-  grpc::Status Distances(grpc::ServerContext* context,
-                         const v1::DistancesRequest* request,
-                         v1::DistancesResponse* response) override {
-    return rpc::Serve(context, request, response, this, &IndexService::Distances);
-  }
-  grpc::Status ListModels(grpc::ServerContext* context,
-                          const v1::ListModelsRequest* request,
-                          v1::ListModelsResponse* response) override {
-    return rpc::Serve(context, request, response, this, &IndexService::ListModels);
-  }
-  grpc::Status Neighbors(grpc::ServerContext* context,
-                         const v1::NeighborsRequest* request,
-                         grpc::ServerWriter<v1::NeighborLists>* writer) override {
-    return rpc::Serve(context, request, writer, this, &IndexService::Neighbors);
-  }
-  grpc::Status PairDistances(grpc::ServerContext* context,
-                             const v1::PairDistancesRequest* request,
-                             v1::PairDistancesResponse* response) override {
-    return rpc::Serve(context, request, response, this, &IndexService::PairDistances);
-  }
 
   /// Bytes held by the in-memory index of every collection (for benchmarks).
   std::size_t MemoryBytes();

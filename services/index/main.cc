@@ -4,7 +4,7 @@
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
 #include "common/rpc/server_main.h"
-#include "services/index/index_service.h"
+#include "services/index/index_grpc.h"
 
 ABSL_FLAG(std::string, data_dir, "", "folder of the index database (required)");
 ABSL_FLAG(int, threads, 0, "threads for ranking (0: all cores)");
@@ -22,5 +22,6 @@ int main(int argc, char** argv) {
   options.postings_max_models = absl::GetFlag(FLAGS_postings_max_models);
   auto service = meshseek::IndexService::Create(options);
   if (!service.ok()) return meshseek::rpc::ExitWithError("index", service.status());
-  return meshseek::rpc::ServeUntilSignal("index", {service->get()});
+  meshseek::IndexGrpc grpc(service->get());
+  return meshseek::rpc::ServeUntilSignal("index", {&grpc});
 }

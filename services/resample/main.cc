@@ -4,7 +4,7 @@
 #include "absl/flags/usage.h"
 #include "common/flags/mesh_limit_flags.h"
 #include "common/rpc/server_main.h"
-#include "services/resample/resample_service.h"
+#include "services/resample/resample_grpc.h"
 
 int main(int argc, char** argv) {
   meshseek::rpc::BlockTerminationSignals();
@@ -13,5 +13,6 @@ int main(int argc, char** argv) {
   auto limits = meshseek::flags::MeshLimitsFromFlags();
   if (!limits.ok()) return meshseek::rpc::ExitWithError("resample", limits.status());
   meshseek::ResampleService service(*limits);
-  return meshseek::rpc::ServeUntilSignal("resample", {&service});
+  meshseek::ResampleGrpc grpc(&service);
+  return meshseek::rpc::ServeUntilSignal("resample", {&grpc});
 }

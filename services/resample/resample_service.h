@@ -5,24 +5,17 @@
 
 #include "common/geometry/mesh_io.h"
 #include "common/rpc/handler.h"
-#include "meshseek/v1/resample.grpc.pb.h"
+#include "meshseek/v1/resample.pb.h"
 
 namespace meshseek {
 
-class ResampleService final : public v1::Resample::Service {
+class ResampleService final {
  public:
   /// `mesh_limits` bound a mesh sent as a file (or as arrays).
   explicit ResampleService(const MeshReadOptions& mesh_limits = {}) : mesh_limits_(mesh_limits) {}
 
   absl::StatusOr<v1::ResampleResponse> Resample(const v1::ResampleRequest& request,
                                                 const rpc::CallContext& call);
-
-  // gRPC entry point (common/rpc/handler.h).
-  grpc::Status Resample(grpc::ServerContext* context,
-                        const v1::ResampleRequest* request,
-                        v1::ResampleResponse* response) override {
-    return rpc::Serve(context, request, response, this, &ResampleService::Resample);
-  }
 
  private:
   const MeshReadOptions mesh_limits_;

@@ -7,8 +7,8 @@
 // words at V = 2,000 for 3,000 descriptors (real DLD-SIFT histograms of
 // McGill use about 700, of PSB about half the words), about 1,600 at
 // V = 20,000. Weights are counts over `descriptors`, as an encoder makes them.
-#ifndef MESHSEEK_BENCH_SYNTHETIC_HISTOGRAMS_H_
-#define MESHSEEK_BENCH_SYNTHETIC_HISTOGRAMS_H_
+#ifndef MESHSEEK_COMMON_SEARCH_SYNTHETIC_HISTOGRAMS_H_
+#define MESHSEEK_COMMON_SEARCH_SYNTHETIC_HISTOGRAMS_H_
 
 #include <algorithm>
 #include <cmath>
@@ -42,4 +42,4 @@ inline SparseHistogram SyntheticHistogram(std::mt19937_64& rng, int vocabulary, 
 
 }  // namespace meshseek
 
-#endif  // MESHSEEK_BENCH_SYNTHETIC_HISTOGRAMS_H_
+#endif  // MESHSEEK_COMMON_SEARCH_SYNTHETIC_HISTOGRAMS_H_

@@ -36,7 +36,7 @@
 #include "absl/flags/flag.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
-#include "bench/synthetic_histograms.h"
+#include "common/search/synthetic_histograms.h"
 #include "common/flags/pipeline_flags.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
