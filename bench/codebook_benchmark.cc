@@ -65,7 +65,8 @@
 ABSL_FLAG(std::string, experiment, "train", "train, encode, libraries or collection");
 ABSL_FLAG(int64_t, points, 1000000, "synthetic training descriptors");
 ABSL_FLAG(int, vocabulary, 20000, "codebook size V");
-ABSL_FLAG(std::string, assignment, "auto", "auto, exact or approximate");
+ABSL_FLAG(std::string, assignment, "auto", "auto, exact, approximate or tree");
+ABSL_FLAG(int, tree_depth, 3, "KMeansOptions::tree_depth (assignment tree)");
 ABSL_FLAG(int, probes, 8, "KMeansOptions::approximate_probes");
 ABSL_FLAG(int, groups, 0, "KMeansOptions::approximate_groups (0: automatic)");
 ABSL_FLAG(std::string, seeding, "auto", "auto, kmeanspp or random");
@@ -192,9 +193,8 @@ KMeansOptions OptionsFromFlags() {
   o.approximate_probes = absl::GetFlag(FLAGS_probes);
   o.approximate_groups = absl::GetFlag(FLAGS_groups);
   const std::string a = absl::GetFlag(FLAGS_assignment);
-  o.assignment = a == "exact"         ? KMeansOptions::Assignment::kExact
-                 : a == "approximate" ? KMeansOptions::Assignment::kApproximate
-                                      : KMeansOptions::Assignment::kAuto;
+  o.assignment = ParseKMeansAssignment(a).value_or(KMeansOptions::Assignment::kAuto);
+  o.tree_depth = absl::GetFlag(FLAGS_tree_depth);
   const std::string s = absl::GetFlag(FLAGS_seeding);
   o.seeding = s == "kmeanspp" ? KMeansOptions::Seeding::kKMeansPlusPlus
               : s == "random" ? KMeansOptions::Seeding::kRandomDistinct

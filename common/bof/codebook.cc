@@ -14,9 +14,11 @@ namespace meshseek {
 namespace {
 
 constexpr char kMagic[4] = {'M', 'S', 'C', 'B'};
-// Version 1: exact search; version 2: approximate, with its two parameters.
+// Version 1: exact search; version 2: approximate, with its two parameters;
+// version 3: a vocabulary tree.
 constexpr uint32_t kExactVersion = 1;
 constexpr uint32_t kApproximateVersion = 2;
+constexpr uint32_t kTreeVersion = 3;
 constexpr std::size_t kHeaderBytes = 4 + 4 + 8 + 8;
 constexpr std::size_t kApproximateHeaderBytes = kHeaderBytes + 4 + 4;
 constexpr std::size_t kChecksumBytes = 8;
@@ -47,6 +49,12 @@ Codebook::Codebook(std::vector<float> centroids,
   }
 }
 
+Codebook::Codebook(VocabularyTree tree)
+    : centroids_(tree.LeafCentres()),
+      size_(tree.num_leaves()),
+      dim_(tree.dim()),
+      tree_(std::make_shared<const VocabularyTree>(std::move(tree))) {}
+
 std::optional<ApproximateSearchParams> Codebook::approximate() const {
   if (approximate_ == nullptr) return std::nullopt;
   return approximate_->params();
@@ -57,6 +65,11 @@ absl::StatusOr<Codebook> Codebook::Train(const uint8_t* descriptors,
                                          std::size_t dim,
                                          const KMeansOptions& options,
                                          KMeansReport* report) {
+  if (options.assignment == KMeansOptions::Assignment::kTree) {
+    MESHSEEK_ASSIGN_OR_RETURN(VocabularyTree tree,
+                              VocabularyTree::Train(descriptors, count, dim, options, report));
+    return Codebook(std::move(tree));
+  }
   MESHSEEK_ASSIGN_OR_RETURN(std::vector<float> centroids,
                             TrainKMeans(descriptors, count, dim, options, report));
   std::optional<ApproximateSearchParams> approximate;
@@ -110,7 +123,9 @@ absl::StatusOr<std::vector<uint32_t>> Codebook::NearestCentroids(const uint8_t* 
         absl::StrCat("codebook: descriptors is null with count ", count));
   }
   std::vector<uint32_t> labels(count);
-  if (approximate_ != nullptr) {
+  if (tree_ != nullptr) {
+    tree_->Search(descriptors, count, /*num_threads=*/1, labels.data(), nullptr);
+  } else if (approximate_ != nullptr) {
     approximate_->Search(descriptors, count, /*num_threads=*/1, labels.data(), nullptr);
   } else {
     index_.Search(descriptors, count, /*num_threads=*/1, labels.data(), nullptr);
@@ -142,6 +157,20 @@ absl::StatusOr<std::vector<float>> Codebook::Encode(const uint8_t* descriptors,
 
 std::string Codebook::Serialize() const {
   std::string out(kMagic, sizeof(kMagic));
+  if (tree_ != nullptr) {
+    PutLittleEndian(kTreeVersion, 4, &out);
+    PutLittleEndian(size(), 8, &out);
+    PutLittleEndian(dim(), 8, &out);
+    PutLittleEndian(tree_->nodes().size(), 4, &out);
+    for (const VocabularyTree::Node& node : tree_->nodes()) {
+      PutLittleEndian(node.first_child, 4, &out);
+      PutLittleEndian(node.num_children, 4, &out);
+      PutLittleEndian(node.leaf, 4, &out);
+    }
+    for (float v : tree_->centres()) PutFloat(v, &out);
+    PutLittleEndian(Fnv1a64(out), 8, &out);
+    return out;
+  }
   out.reserve(kApproximateHeaderBytes + centroids_.size() * 4 + kChecksumBytes);
   PutLittleEndian(approximate_ != nullptr ? kApproximateVersion : kExactVersion, 4, &out);
   PutLittleEndian(size(), 8, &out);
@@ -167,13 +196,14 @@ absl::StatusOr<Codebook> Codebook::Deserialize(absl::string_view bytes) {
     return absl::InvalidArgumentError("codebook: bad magic (expected \"MSCB\")");
   }
   const uint64_t version = GetLittleEndian(bytes.data() + 4, 4);
+  if (version == kTreeVersion) return DeserializeTree(bytes);
   if (version != kExactVersion && version != kApproximateVersion) {
     return absl::InvalidArgumentError(absl::StrCat("codebook: unsupported version ",
                                                    version,
                                                    " (this build reads ",
                                                    kExactVersion,
-                                                   " and ",
-                                                   kApproximateVersion,
+                                                   " to ",
+                                                   kTreeVersion,
                                                    ")"));
   }
   const std::size_t header =
@@ -229,6 +259,51 @@ absl::StatusOr<Codebook> Codebook::Deserialize(absl::string_view bytes) {
     centroids[i] = GetFloat(bytes.data() + header + 4 * i);
   }
   return FromCentroids(std::move(centroids), dim, approximate);
+}
+
+// Version 3. The caller has checked the length against the version-1 header,
+// the magic and the version.
+absl::StatusOr<Codebook> Codebook::DeserializeTree(absl::string_view bytes) {
+  constexpr std::size_t kNodesAt = kHeaderBytes + 4;
+  constexpr std::size_t kNodeBytes = 12;
+  if (bytes.size() < kNodesAt + kChecksumBytes) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("codebook: got ", bytes.size(), " bytes, shorter than a tree's header"));
+  }
+  const uint64_t size = GetLittleEndian(bytes.data() + 8, 8);
+  const uint64_t dim = GetLittleEndian(bytes.data() + 16, 8);
+  const uint64_t nodes = GetLittleEndian(bytes.data() + kHeaderBytes, 4);
+  // Each factor is bounded by the byte count before multiplying.
+  const uint64_t room = bytes.size() - kNodesAt - kChecksumBytes;
+  if (nodes < 2 || dim == 0 || size == 0 || nodes > room / kNodeBytes ||
+      dim > room / 4 / (nodes - 1) ||
+      kNodesAt + nodes * kNodeBytes + (nodes - 1) * dim * 4 + kChecksumBytes != bytes.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("codebook: header says a tree of ", nodes,
+                                                   " nodes x ", dim, " dims, inconsistent with ",
+                                                   bytes.size(), " bytes"));
+  }
+  const std::size_t payload = bytes.size() - kChecksumBytes;
+  if (Fnv1a64(bytes.substr(0, payload)) != GetLittleEndian(bytes.data() + payload, 8)) {
+    return absl::InvalidArgumentError("codebook: checksum mismatch (corrupt data)");
+  }
+  std::vector<VocabularyTree::Node> tree_nodes(nodes);
+  const char* at = bytes.data() + kNodesAt;
+  for (VocabularyTree::Node& node : tree_nodes) {
+    node.first_child = static_cast<uint32_t>(GetLittleEndian(at, 4));
+    node.num_children = static_cast<uint32_t>(GetLittleEndian(at + 4, 4));
+    node.leaf = static_cast<uint32_t>(GetLittleEndian(at + 8, 4));
+    at += kNodeBytes;
+  }
+  std::vector<float> centres((nodes - 1) * dim);
+  for (std::size_t i = 0; i < centres.size(); ++i) centres[i] = GetFloat(at + 4 * i);
+  MESHSEEK_ASSIGN_OR_RETURN(
+      VocabularyTree tree,
+      VocabularyTree::FromNodes(std::move(tree_nodes), std::move(centres), dim));
+  if (tree.num_leaves() != size) {
+    return absl::InvalidArgumentError(absl::StrCat("codebook: header says ", size,
+                                                   " words, the tree has ", tree.num_leaves()));
+  }
+  return Codebook(std::move(tree));
 }
 
 }  // namespace meshseek

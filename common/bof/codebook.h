@@ -12,7 +12,9 @@
 //    two-level search: 81 ms CPU per model of 2,500 descriptors at V = 20,000
 //    against 395 ms exact, finding the exact nearest word for 96.6% of them.
 //    A word found is the one training would have assigned the same
-//    descriptor to, so histograms match the clusters.
+//    descriptor to, so histograms match the clusters;
+//  - tree (vocabulary_tree.h): the words are a vocabulary tree's leaves, and
+//    a descriptor's word is the leaf its descent reaches, as in training.
 //
 // A Codebook is immutable once made; its const methods may be called from
 // several threads at once.
@@ -22,7 +24,11 @@
 //                 V * dim float32, row-major | uint64 FNV-1a 64 hash of every
 //                 preceding byte;
 //   approximate:  "MSCB" | uint32 version (2) | uint64 V | uint64 dim |
-//                 uint32 groups | uint32 probes | V * dim float32 | hash.
+//                 uint32 groups | uint32 probes | V * dim float32 | hash;
+//   tree:         "MSCB" | uint32 version (3) | uint64 V | uint64 dim |
+//                 uint32 N nodes | N * (uint32 first_child, uint32
+//                 num_children, uint32 leaf), breadth first |
+//                 (N - 1) * dim float32, the non-root nodes' centres | hash.
 // Exact codebooks keep writing version 1, so their bytes are unchanged and
 // older readers read them. The approximate search's grouping is rebuilt from
 // the centroids (it is a deterministic function of them, groups and probes).
@@ -42,6 +48,7 @@
 #include "common/bof/approximate_nearest_centroid.h"
 #include "common/bof/kmeans.h"
 #include "common/bof/nearest_centroid.h"
+#include "common/bof/vocabulary_tree.h"
 
 namespace meshseek {
 
@@ -78,6 +85,8 @@ class Codebook {
   /// The approximate search's parameters when the codebook encodes with it;
   /// nullopt when it encodes by exact search.
   std::optional<ApproximateSearchParams> approximate() const;
+  /// The vocabulary tree whose leaves are the words, or nullptr.
+  const VocabularyTree* tree() const { return tree_.get(); }
 
   /// Index of the nearest word for each of `count` descriptors (count x dim()
   /// row-major; ties go to the lowest index), by the codebook's search (exact,
@@ -110,14 +119,18 @@ class Codebook {
            std::size_t dim,
            const std::optional<ApproximateSearchParams>& approximate,
            int num_threads);
+  explicit Codebook(VocabularyTree tree);
+  static absl::StatusOr<Codebook> DeserializeTree(absl::string_view bytes);
 
   std::vector<float> centroids_;
   std::size_t size_ = 0;
   std::size_t dim_ = 0;
-  // Exactly one of the two is built: index_ for exact search, approximate_
-  // (shared: immutable, and copies of a Codebook need not regroup) otherwise.
+  // Exactly one of the three is built: index_ for exact search, approximate_
+  // or tree_ (shared: immutable, and copies of a Codebook need not rebuild
+  // them) otherwise.
   NearestCentroidIndex index_;
   std::shared_ptr<const ApproximateNearestCentroidIndex> approximate_;
+  std::shared_ptr<const VocabularyTree> tree_;
 };
 
 }  // namespace meshseek

@@ -162,8 +162,8 @@ TEST(CodebookTest, DeserializeRejectsCorruptInput) {
   EXPECT_THAT(message(bad), HasSubstr("bad magic"));
 
   bad = good;
-  bad[4] = 3;
-  EXPECT_THAT(message(bad), HasSubstr("unsupported version 3 (this build reads 1 and 2)"));
+  bad[4] = 4;
+  EXPECT_THAT(message(bad), HasSubstr("unsupported version 4 (this build reads 1 to 3)"));
 
   bad = good;
   bad[4] = 2;  // a version-1 body read with the longer version-2 header

@@ -175,6 +175,10 @@ absl::StatusOr<std::vector<float>> TrainKMeansImpl(const T* points,
                                                    KMeansReport* report,
                                                    bool log_summary) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
+  if (options.assignment == KMeansOptions::Assignment::kTree) {
+    return absl::InvalidArgumentError(
+        "k-means: a vocabulary tree (assignment 'tree') is trained by VocabularyTree::Train");
+  }
   const std::size_t k = static_cast<std::size_t>(options.num_centroids);
   if (dim == 0) return absl::InvalidArgumentError("k-means: dim must be >= 1, got 0");
   if (n < k) {
@@ -358,8 +362,12 @@ absl::Status KMeansOptions::Validate() const {
     return bad("init_points_per_centroid", init_points_per_centroid, ">= 1");
   }
   if (assignment != Assignment::kAuto && assignment != Assignment::kExact &&
-      assignment != Assignment::kApproximate) {
-    return bad("assignment", static_cast<int>(assignment), "kAuto, kExact or kApproximate");
+      assignment != Assignment::kApproximate && assignment != Assignment::kTree) {
+    return bad("assignment", static_cast<int>(assignment), "kAuto, kExact, kApproximate or kTree");
+  }
+  if (tree_depth < 1 || tree_depth > 8) return bad("tree_depth", tree_depth, "in [1, 8]");
+  if (assignment == Assignment::kTree && num_centroids < 2) {
+    return bad("num_centroids", num_centroids, ">= 2 for a vocabulary tree");
   }
   if (approximate_min_centroids < 1) {
     return bad("approximate_min_centroids", approximate_min_centroids, ">= 1");
@@ -391,6 +399,7 @@ absl::Status KMeansOptions::Validate() const {
 bool KMeansOptions::UsesApproximateAssignment() const {
   switch (assignment) {
     case Assignment::kExact:
+    case Assignment::kTree:
       return false;
     case Assignment::kApproximate:
       return true;
@@ -425,6 +434,8 @@ const char* KMeansAssignmentName(KMeansOptions::Assignment assignment) {
       return "exact";
     case KMeansOptions::Assignment::kApproximate:
       return "approximate";
+    case KMeansOptions::Assignment::kTree:
+      return "tree";
   }
   return "?";
 }
@@ -433,8 +444,9 @@ absl::StatusOr<KMeansOptions::Assignment> ParseKMeansAssignment(absl::string_vie
   if (name.empty() || name == "auto") return KMeansOptions::Assignment::kAuto;
   if (name == "exact") return KMeansOptions::Assignment::kExact;
   if (name == "approximate") return KMeansOptions::Assignment::kApproximate;
+  if (name == "tree") return KMeansOptions::Assignment::kTree;
   return absl::InvalidArgumentError(absl::StrCat(
-      "k-means assignment must be 'auto', 'exact' or 'approximate', got '", name, "'"));
+      "k-means assignment must be 'auto', 'exact', 'approximate' or 'tree', got '", name, "'"));
 }
 
 std::vector<std::size_t> KMeansTrainingRows(std::size_t n, const KMeansOptions& options) {
@@ -468,6 +480,14 @@ absl::StatusOr<std::vector<float>> TrainKMeans(const uint8_t* points,
 namespace internal {
 
 absl::StatusOr<std::vector<float>> TrainKMeansQuietly(const float* points,
+                                                      std::size_t n,
+                                                      std::size_t dim,
+                                                      const KMeansOptions& options,
+                                                      KMeansReport* report) {
+  return TrainKMeansImpl(points, n, dim, options, report, /*log_summary=*/false);
+}
+
+absl::StatusOr<std::vector<float>> TrainKMeansQuietly(const uint8_t* points,
                                                       std::size_t n,
                                                       std::size_t dim,
                                                       const KMeansOptions& options,

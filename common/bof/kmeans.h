@@ -64,6 +64,11 @@ struct KMeansOptions {
     /// The nearest among the centroids of the approximate_probes nearest of
     /// approximate_groups groups (approximate_nearest_centroid.h).
     kApproximate = 2,
+    /// Not flat k-means: the words are the leaves of a vocabulary tree of
+    /// tree_depth levels, learnt by hierarchical k-means and searched by
+    /// descending it (vocabulary_tree.h). A Codebook trains one; TrainKMeans
+    /// refuses it.
+    kTree = 3,
   };
   /// How the initial centroids are chosen (step 2 above).
   enum class Seeding {
@@ -129,6 +134,9 @@ struct KMeansOptions {
   uint64_t sampled_from = 0;
   /// See Seeding.
   Seeding seeding = Seeding::kAuto;
+  /// Levels of a vocabulary tree (assignment kTree), 1..8: about
+  /// depth x V^(1/depth) distances a descriptor (105 at V = 40,000, depth 3).
+  int tree_depth = 3;
   /// kAuto's threshold for k-means++: O(V^2 init_points_per_centroid dim)
   /// multiply-adds, 4 G at V = 2,000 but 410 G at V = 20,000, where random
   /// distinct seeds cost nothing and Lloyd catches up (bench/results/codebook.txt).
@@ -146,7 +154,7 @@ struct KMeansOptions {
   bool UsesKMeansPlusPlus() const;
 };
 
-/// "auto", "exact" or "approximate": the names flags and the wire use.
+/// "auto", "exact", "approximate" or "tree": the names flags and the wire use.
 const char* KMeansAssignmentName(KMeansOptions::Assignment assignment);
 /// The assignment named so ("" is "auto"), or InvalidArgument.
 absl::StatusOr<KMeansOptions::Assignment> ParseKMeansAssignment(absl::string_view name);
@@ -197,8 +205,14 @@ absl::StatusOr<std::vector<float>> TrainKMeans(const uint8_t* points,
 namespace internal {
 
 /// TrainKMeans without the summary line it logs at INFO: the approximate
-/// search groups the centroids by k-means once per Lloyd iteration.
+/// search groups the centroids by k-means once per Lloyd iteration, and a
+/// vocabulary tree runs one k-means a node.
 absl::StatusOr<std::vector<float>> TrainKMeansQuietly(const float* points,
+                                                      std::size_t n,
+                                                      std::size_t dim,
+                                                      const KMeansOptions& options,
+                                                      KMeansReport* report);
+absl::StatusOr<std::vector<float>> TrainKMeansQuietly(const uint8_t* points,
                                                       std::size_t n,
                                                       std::size_t dim,
                                                       const KMeansOptions& options,

@@ -101,12 +101,12 @@ TEST(KMeansOptionsTest, AutomaticChoicesFollowTheVocabularySize) {
 
 TEST(KMeansOptionsTest, AssignmentNamesRoundTrip) {
   for (const auto a : {KMeansOptions::Assignment::kAuto, KMeansOptions::Assignment::kExact,
-                       KMeansOptions::Assignment::kApproximate}) {
+                       KMeansOptions::Assignment::kApproximate, KMeansOptions::Assignment::kTree}) {
     EXPECT_EQ(*ParseKMeansAssignment(KMeansAssignmentName(a)), a);
   }
   EXPECT_EQ(*ParseKMeansAssignment(""), KMeansOptions::Assignment::kAuto);
   EXPECT_THAT(ParseKMeansAssignment("fast").status().message(),
-              ::testing::HasSubstr("must be 'auto', 'exact' or 'approximate', got 'fast'"));
+              ::testing::HasSubstr("must be 'auto', 'exact', 'approximate' or 'tree', got 'fast'"));
 }
 
 TEST(KMeansOptionsTest, RejectsBadFieldsNamingThem) {
@@ -129,7 +129,8 @@ TEST(KMeansOptionsTest, RejectsBadFieldsNamingThem) {
       {[](KMeansOptions& o) { o.init_points_per_centroid = 0; },
        "init_points_per_centroid must be >= 1, got 0"},
       {[](KMeansOptions& o) { o.assignment = static_cast<KMeansOptions::Assignment>(7); },
-       "assignment must be kAuto, kExact or kApproximate, got 7"},
+       "assignment must be kAuto, kExact, kApproximate or kTree, got 7"},
+      {[](KMeansOptions& o) { o.tree_depth = 0; }, "tree_depth must be in [1, 8], got 0"},
       {[](KMeansOptions& o) { o.approximate_min_centroids = 0; },
        "approximate_min_centroids must be >= 1, got 0"},
       {[](KMeansOptions& o) { o.approximate_groups = -1; },

@@ -71,7 +71,10 @@ absl::Status RetrievalPipelineOptions::Validate() const {
 Json RetrievalPipelineOptions::ToJson(bool with_threads) const {
   Json json = PipelineParamsToJson(*this);
   if (FeatureMethodInfoOf(extractor.method).kind == DescriptorKind::kBagOfFeatures) {
-    json.Set("nearest_word_search", kmeans.UsesApproximateAssignment() ? "approximate" : "exact");
+    json.Set("nearest_word_search",
+             kmeans.assignment == KMeansOptions::Assignment::kTree ? "tree"
+             : kmeans.UsesApproximateAssignment()                  ? "approximate"
+                                                                   : "exact");
     json.Set("distance", "symmetric KL divergence");
   }
   if (with_threads) json.Set("threads", ResolveThreadCount(num_threads));
