@@ -295,6 +295,9 @@ std::vector<ParamSpec> RankingRows() {
           kBagOfFeatures, OF(o.kmeans.assignment),
           "nearest-word search of k-means and encoding: auto (exact below V = 1,000, approximate "
           "from there) | exact | approximate | tree (the words a vocabulary tree's leaves)"),
+    Param("kmeans_tree_depth", Range(1, 8), kBagOfFeatures, OF(o.kmeans.tree_depth),
+          "levels of the vocabulary tree (kmeans_assignment=tree): about depth x V^(1/depth) "
+          "distances a descriptor"),
     Param("seed", Range(0, kMaxSeed), kBagOfFeatures, OF(o.kmeans.seed),
           "seed of k-means sampling and seeding"),
     Param("idf", Range(0, 1), kBagOfFeatures, OF(o.weighting.idf),
