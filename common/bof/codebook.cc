@@ -162,6 +162,7 @@ std::string Codebook::Serialize() const {
     PutLittleEndian(size(), 8, &out);
     PutLittleEndian(dim(), 8, &out);
     PutLittleEndian(tree_->nodes().size(), 4, &out);
+    PutLittleEndian(tree_->probes(), 4, &out);
     for (const VocabularyTree::Node& node : tree_->nodes()) {
       PutLittleEndian(node.first_child, 4, &out);
       PutLittleEndian(node.num_children, 4, &out);
@@ -264,7 +265,7 @@ absl::StatusOr<Codebook> Codebook::Deserialize(absl::string_view bytes) {
 // Version 3. The caller has checked the length against the version-1 header,
 // the magic and the version.
 absl::StatusOr<Codebook> Codebook::DeserializeTree(absl::string_view bytes) {
-  constexpr std::size_t kNodesAt = kHeaderBytes + 4;
+  constexpr std::size_t kNodesAt = kHeaderBytes + 8;
   constexpr std::size_t kNodeBytes = 12;
   if (bytes.size() < kNodesAt + kChecksumBytes) {
     return absl::InvalidArgumentError(
@@ -273,6 +274,7 @@ absl::StatusOr<Codebook> Codebook::DeserializeTree(absl::string_view bytes) {
   const uint64_t size = GetLittleEndian(bytes.data() + 8, 8);
   const uint64_t dim = GetLittleEndian(bytes.data() + 16, 8);
   const uint64_t nodes = GetLittleEndian(bytes.data() + kHeaderBytes, 4);
+  const auto probes = static_cast<uint32_t>(GetLittleEndian(bytes.data() + kHeaderBytes + 4, 4));
   // Each factor is bounded by the byte count before multiplying.
   const uint64_t room = bytes.size() - kNodesAt - kChecksumBytes;
   if (nodes < 2 || dim == 0 || size == 0 || nodes > room / kNodeBytes ||
@@ -298,7 +300,7 @@ absl::StatusOr<Codebook> Codebook::DeserializeTree(absl::string_view bytes) {
   for (std::size_t i = 0; i < centres.size(); ++i) centres[i] = GetFloat(at + 4 * i);
   MESHSEEK_ASSIGN_OR_RETURN(
       VocabularyTree tree,
-      VocabularyTree::FromNodes(std::move(tree_nodes), std::move(centres), dim));
+      VocabularyTree::FromNodes(std::move(tree_nodes), std::move(centres), dim, probes));
   if (tree.num_leaves() != size) {
     return absl::InvalidArgumentError(absl::StrCat("codebook: header says ", size,
                                                    " words, the tree has ", tree.num_leaves()));

@@ -26,7 +26,7 @@
 //   approximate:  "MSCB" | uint32 version (2) | uint64 V | uint64 dim |
 //                 uint32 groups | uint32 probes | V * dim float32 | hash;
 //   tree:         "MSCB" | uint32 version (3) | uint64 V | uint64 dim |
-//                 uint32 N nodes | N * (uint32 first_child, uint32
+//                 uint32 N nodes | uint32 probes | N * (uint32 first_child, uint32
 //                 num_children, uint32 leaf), breadth first |
 //                 (N - 1) * dim float32, the non-root nodes' centres | hash.
 // Exact codebooks keep writing version 1, so their bytes are unchanged and

@@ -366,6 +366,7 @@ absl::Status KMeansOptions::Validate() const {
     return bad("assignment", static_cast<int>(assignment), "kAuto, kExact, kApproximate or kTree");
   }
   if (tree_depth < 1 || tree_depth > 8) return bad("tree_depth", tree_depth, "in [1, 8]");
+  if (tree_probes < 1 || tree_probes > 64) return bad("tree_probes", tree_probes, "in [1, 64]");
   if (assignment == Assignment::kTree && num_centroids < 2) {
     return bad("num_centroids", num_centroids, ">= 2 for a vocabulary tree");
   }

@@ -137,6 +137,9 @@ struct KMeansOptions {
   /// Levels of a vocabulary tree (assignment kTree), 1..8: about
   /// depth x V^(1/depth) distances a descriptor (105 at V = 40,000, depth 3).
   int tree_depth = 3;
+  /// Nodes a vocabulary tree's search keeps at each level, 1..64 (1: the plain
+  /// descent; vocabulary_tree.h).
+  int tree_probes = 1;
   /// kAuto's threshold for k-means++: O(V^2 init_points_per_centroid dim)
   /// multiply-adds, 4 G at V = 2,000 but 410 G at V = 20,000, where random
   /// distinct seeds cost nothing and Lloyd catches up (bench/results/codebook.txt).

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <numeric>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "common/base/logging.h"
+#include "common/base/parallel.h"
 #include "common/base/status_macros.h"
 
 namespace meshseek {
@@ -59,6 +61,36 @@ std::vector<uint8_t> Gather(const uint8_t* points,
   return out;
 }
 
+// Each point's beam: up to `width` (score, node) pairs in increasing order,
+// unused slots at +inf.
+struct Beams {
+  Beams(std::size_t count, std::size_t width)
+      : width(width),
+        score(count * width, std::numeric_limits<float>::infinity()),
+        node(count * width, 0) {}
+  void Clear() {
+    std::fill(score.begin(), score.end(), std::numeric_limits<float>::infinity());
+    std::fill(node.begin(), node.end(), 0u);
+  }
+  // Keeps the best `width` of point i's candidates: by score, then node.
+  void Offer(std::size_t i, float s, uint32_t id) {
+    float* b = &score[i * width];
+    uint32_t* bn = &node[i * width];
+    auto before = [&](std::size_t j) { return s < b[j] || (s == b[j] && id < bn[j]); };
+    if (!before(width - 1)) return;
+    std::size_t j = width - 1;
+    for (; j > 0 && before(j - 1); --j) {
+      b[j] = b[j - 1];
+      bn[j] = bn[j - 1];
+    }
+    b[j] = s;
+    bn[j] = id;
+  }
+  std::size_t width;
+  std::vector<float> score;
+  std::vector<uint32_t> node;
+};
+
 }  // namespace
 
 absl::StatusOr<VocabularyTree> VocabularyTree::Train(const uint8_t* points,
@@ -84,13 +116,33 @@ absl::StatusOr<VocabularyTree> VocabularyTree::Train(const uint8_t* points,
   } else {
     sample = KMeansTrainingRows(n, options);
   }
-  std::vector<uint32_t> all_rows(sample.begin(), sample.end());
-  const std::vector<uint8_t> train = Gather(points, dim, all_rows);
-  std::iota(all_rows.begin(), all_rows.end(), 0u);
+  const std::vector<uint8_t> train =
+      Gather(points, dim, std::vector<uint32_t>(sample.begin(), sample.end()));
 
   VocabularyTree tree;
   tree.dim_ = dim;
-  tree.nodes_.emplace_back();
+  tree.probes_ = static_cast<uint32_t>(options.tree_probes);
+  MESHSEEK_RETURN_IF_ERROR(tree.Grow(train, options));
+  const std::vector<double> objective = tree.Refine(train, kRefinements, options.num_threads);
+  if (report != nullptr) {
+    *report = KMeansReport();
+    report->input_points = n;
+    report->training_points = sample.size();
+    report->iterations = kRefinements;
+    report->objective = objective;
+  }
+  MESHSEEK_LOG(INFO) << "vocabulary tree: " << tree.num_leaves() << " leaves, depth "
+                     << tree.depth() << ", " << tree.nodes_.size() << " nodes, " << tree.probes_
+                     << " probes, from " << sample.size() << " of " << n
+                     << " points, mean squared distance " << objective.front() << " grown, "
+                     << objective.back() << " refined, "
+                     << absl::FormatDuration(
+                            absl::Trunc(absl::Now() - start, absl::Milliseconds(1)));
+  return tree;
+}
+
+absl::Status VocabularyTree::Grow(const std::vector<uint8_t>& train, const KMeansOptions& options) {
+  const std::size_t dim = dim_;
   struct Pending {
     uint32_t node;
     std::vector<uint32_t> rows;  // into train
@@ -98,26 +150,15 @@ absl::StatusOr<VocabularyTree> VocabularyTree::Train(const uint8_t* points,
     int levels;
   };
   std::deque<Pending> pending;
-  pending.push_back({0, std::move(all_rows), leaves, options.tree_depth});
-  double objective = 0;
+  std::vector<uint32_t> all_rows(train.size() / dim);
+  std::iota(all_rows.begin(), all_rows.end(), 0u);
+  nodes_.assign(1, Node());
+  pending.push_back(
+      {0, std::move(all_rows), static_cast<uint32_t>(options.num_centroids), options.tree_depth});
   while (!pending.empty()) {
     Pending at = std::move(pending.front());
     pending.pop_front();
-    if (at.leaves == 1 || at.levels == 0) {
-      // A leaf: the squared distances of its points to its centre.
-      if (at.node != 0) {
-        const float* centre = &tree.centres_[(at.node - 1) * dim];
-        for (uint32_t row : at.rows) {
-          double d = 0;
-          for (std::size_t j = 0; j < dim; ++j) {
-            const double diff = train[row * dim + j] - centre[j];
-            d += diff * diff;
-          }
-          objective += d;
-        }
-      }
-      continue;
-    }
+    if (at.leaves == 1 || at.levels == 0) continue;  // a leaf
     uint32_t k = at.levels == 1 ? at.leaves
                                 : static_cast<uint32_t>(std::lround(
                                       std::pow(static_cast<double>(at.leaves), 1.0 / at.levels)));
@@ -130,13 +171,13 @@ absl::StatusOr<VocabularyTree> VocabularyTree::Train(const uint8_t* points,
     node.sampled_from = 0;
     node.seed = NodeSeed(options.seed, at.node);
     node.min_points_per_centroid = 1;
-    node.max_points_per_centroid =
-        at.levels == 1 ? static_cast<int>((at.rows.size() + k - 1) / k) : kNodePointsPerCentroid;
-    node.max_points_per_centroid = std::max(node.max_points_per_centroid, 1);
+    // The last level trains on all its points: its centres are words.
+    const int all_points = static_cast<int>((at.rows.size() + k - 1) / k);
+    node.max_points_per_centroid = std::max(1, at.levels == 1 ? all_points : kNodePointsPerCentroid);
     MESHSEEK_ASSIGN_OR_RETURN(
         std::vector<float> centres,
         internal::TrainKMeansQuietly(node_points.data(), at.rows.size(), dim, node, nullptr));
-    // Every point of the node to its nearest child, as Search() will.
+    // Every point of the node to its nearest child: the descent.
     std::vector<uint32_t> labels(at.rows.size());
     NearestCentroidIndex(centres.data(), k, dim)
         .Search(node_points.data(), at.rows.size(), options.num_threads, labels.data(), nullptr);
@@ -146,43 +187,66 @@ absl::StatusOr<VocabularyTree> VocabularyTree::Train(const uint8_t* points,
     for (uint32_t c = 0; c < k; ++c) counts[c] = child_rows[c].size();
     const std::vector<uint32_t> share = ShareLeaves(at.leaves, counts);
 
-    const auto first = static_cast<uint32_t>(tree.nodes_.size());
-    tree.nodes_[at.node].first_child = first;
-    tree.nodes_[at.node].num_children = k;
-    tree.nodes_.resize(first + k);
-    tree.centres_.insert(tree.centres_.end(), centres.begin(), centres.end());
+    const auto first = static_cast<uint32_t>(nodes_.size());
+    nodes_[at.node].first_child = first;
+    nodes_[at.node].num_children = k;
+    nodes_.resize(first + k);
+    centres_.insert(centres_.end(), centres.begin(), centres.end());
     for (uint32_t c = 0; c < k; ++c) {
       pending.push_back({first + c, std::move(child_rows[c]), share[c], at.levels - 1});
     }
   }
   uint32_t leaf = 0;
-  for (Node& node : tree.nodes_) {
+  for (Node& node : nodes_) {
     if (node.num_children == 0) node.leaf = leaf++;
   }
-  tree.Index();
-  if (report != nullptr) {
-    *report = KMeansReport();
-    report->input_points = n;
-    report->training_points = train.size() / dim;
-    report->iterations = options.max_iterations;
-    report->objective.push_back(objective / static_cast<double>(report->training_points));
+  Index();
+  return absl::OkStatus();
+}
+
+std::vector<double> VocabularyTree::Refine(const std::vector<uint8_t>& train,
+                                           int iterations,
+                                           int num_threads) {
+  const std::size_t dim = dim_;
+  const std::size_t n = train.size() / dim;
+  std::vector<uint32_t> labels(n);
+  std::vector<float> distances(n);
+  std::vector<double> objective;
+  for (int it = 0;; ++it) {
+    Search(train.data(), n, num_threads, labels.data(), distances.data());
+    double sum = 0;
+    for (float d : distances) sum += d;
+    objective.push_back(sum / static_cast<double>(n));
+    if (it == iterations) return objective;
+    // Each leaf's centre to the mean of its points (sums in point order, in
+    // double: the same for any thread count); a leaf without points stays.
+    std::vector<double> sums(num_leaves() * dim, 0.0);
+    std::vector<std::size_t> counts(num_leaves(), 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      ++counts[labels[i]];
+      double* s = &sums[labels[i] * dim];
+      for (std::size_t j = 0; j < dim; ++j) s[j] += train[i * dim + j];
+    }
+    for (std::size_t w = 0; w < num_leaves(); ++w) {
+      if (counts[w] == 0) continue;
+      float* centre = &centres_[(leaf_node_[w] - 1) * dim];
+      for (std::size_t j = 0; j < dim; ++j) {
+        centre[j] = static_cast<float>(sums[w * dim + j] / static_cast<double>(counts[w]));
+      }
+    }
+    Index();
   }
-  MESHSEEK_LOG(INFO) << "vocabulary tree: " << tree.num_leaves() << " leaves, depth "
-                     << tree.depth() << ", " << tree.nodes_.size() << " nodes, from "
-                     << train.size() / dim << " of " << n << " points, mean squared distance "
-                     << objective / static_cast<double>(train.size() / dim) << ", "
-                     << absl::FormatDuration(
-                            absl::Trunc(absl::Now() - start, absl::Milliseconds(1)));
-  return tree;
 }
 
 absl::StatusOr<VocabularyTree> VocabularyTree::FromNodes(std::vector<Node> nodes,
                                                          std::vector<float> centres,
-                                                         std::size_t dim) {
+                                                         std::size_t dim,
+                                                         uint32_t probes) {
   auto bad = [](auto&&... parts) {
     return absl::InvalidArgumentError(absl::StrCat("vocabulary tree: ", parts...));
   };
   if (dim == 0) return bad("dim must be >= 1");
+  if (probes < 1 || probes > kMaxProbes) return bad(probes, " probes (want 1 to ", kMaxProbes, ")");
   if (nodes.empty() || nodes.size() >= (uint64_t{1} << 32)) {
     return bad(nodes.size(), " nodes (want 1 to 2^32 - 1)");
   }
@@ -221,6 +285,7 @@ absl::StatusOr<VocabularyTree> VocabularyTree::FromNodes(std::vector<Node> nodes
   }
   VocabularyTree tree;
   tree.dim_ = dim;
+  tree.probes_ = probes;
   tree.nodes_ = std::move(nodes);
   tree.centres_ = std::move(centres);
   tree.Index();
@@ -259,41 +324,85 @@ void VocabularyTree::Search(const uint8_t* points,
                             int num_threads,
                             uint32_t* labels,
                             float* squared_distances) const {
-  // Each point's node, moved one level down per pass; points bucketed by node
-  // (counting sort, stable) so each node searches its points in one block.
-  std::vector<uint32_t> at(n, 0);
-  std::vector<float> distance(n, 0.0f);
-  std::vector<uint32_t> order(n), block_labels;
-  std::vector<float> block_distances;
-  std::vector<uint8_t> block;
+  const std::size_t num_blocks = (n + kPointsPerBlock - 1) / kPointsPerBlock;
+  ParallelFor(num_blocks, num_threads, [&](std::size_t block) {
+    const std::size_t begin = block * kPointsPerBlock;
+    SearchBlock(points + begin * dim_, std::min(kPointsPerBlock, n - begin), labels + begin,
+                squared_distances == nullptr ? nullptr : squared_distances + begin);
+  });
+}
+
+void VocabularyTree::SearchBlock(const uint8_t* points,
+                                 std::size_t count,
+                                 uint32_t* labels,
+                                 float* squared_distances) const {
+  const std::size_t dim = dim_;
+  const std::size_t beam = probes_;
+  std::vector<float> x(count * dim);
+  for (std::size_t i = 0; i < count * dim; ++i) x[i] = static_cast<float>(points[i]);
+  // Scores are ||c||^2 - 2 x.c of a node's centre: comparable across nodes
+  // for one point (nearest_centroid.h). The beams start at the root.
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  Beams beams(count, beam), next(count, beam);
+  for (std::size_t i = 0; i < count; ++i) beams.score[i * beam] = 0.0f;
+  std::vector<float>& score = beams.score;
+  std::vector<uint32_t>& node = beams.node;
+  std::vector<uint32_t> offsets(nodes_.size() + 1), bucket, local;
+  std::vector<float> batch, local_score;
   for (int pass = 0; pass < depth_; ++pass) {
-    std::vector<uint32_t> start(nodes_.size() + 1, 0);
-    for (std::size_t i = 0; i < n; ++i) ++start[at[i] + 1];
-    std::partial_sum(start.begin(), start.end(), start.begin());
-    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < n; ++i) order[fill[at[i]]++] = static_cast<uint32_t>(i);
-    for (std::size_t node = 0; node < nodes_.size(); ++node) {
-      const uint32_t begin = start[node], end = start[node + 1];
-      if (begin == end || nodes_[node].num_children == 0) continue;
-      const std::size_t m = end - begin;
-      block.resize(m * dim_);
-      for (std::size_t i = 0; i < m; ++i) {
-        std::copy_n(points + static_cast<std::size_t>(order[begin + i]) * dim_, dim_,
-                    block.data() + i * dim_);
-      }
-      block_labels.resize(m);
-      block_distances.resize(m);
-      children_[node].Search(block.data(), m, num_threads, block_labels.data(),
-                             block_distances.data());
-      for (std::size_t i = 0; i < m; ++i) {
-        at[order[begin + i]] = nodes_[node].first_child + block_labels[i];
-        distance[order[begin + i]] = block_distances[i];
+    next.Clear();
+    // Leaves stay in the beam; internal nodes are bucketed (counting sort)
+    // so that each searches its points' block at once.
+    std::fill(offsets.begin(), offsets.end(), 0u);
+    for (std::size_t e = 0; e < count * beam; ++e) {
+      if (score[e] == kInf) continue;
+      if (nodes_[node[e]].num_children == 0) {
+        next.Offer(e / beam, score[e], node[e]);
+      } else {
+        ++offsets[node[e] + 1];
       }
     }
+    std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+    bucket.resize(offsets.back());
+    {
+      std::vector<uint32_t> fill(offsets.begin(), offsets.end() - 1);
+      for (std::size_t e = 0; e < count * beam; ++e) {
+        if (score[e] != kInf && nodes_[node[e]].num_children > 0) {
+          bucket[fill[node[e]]++] = static_cast<uint32_t>(e / beam);
+        }
+      }
+    }
+    for (std::size_t id = 0; id < nodes_.size(); ++id) {
+      const std::size_t m = offsets[id + 1] - offsets[id];
+      if (m == 0) continue;
+      const Node& at = nodes_[id];
+      const std::size_t k = std::min<std::size_t>(beam, at.num_children);
+      batch.resize(m * dim);
+      for (std::size_t j = 0; j < m; ++j) {
+        std::copy_n(&x[bucket[offsets[id] + j] * dim], dim, &batch[j * dim]);
+      }
+      local.resize(m * k);
+      local_score.resize(m * k);
+      children_[id].SearchTopK(batch.data(), m, k, local.data(), local_score.data());
+      for (std::size_t j = 0; j < m; ++j) {
+        for (std::size_t c = 0; c < k; ++c) {
+          next.Offer(bucket[offsets[id] + j], local_score[j * k + c],
+                     at.first_child + local[j * k + c]);
+        }
+      }
+    }
+    score.swap(next.score);
+    node.swap(next.node);
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    labels[i] = nodes_[at[i]].leaf;
-    if (squared_distances != nullptr) squared_distances[i] = distance[i];
+  for (std::size_t i = 0; i < count; ++i) {
+    labels[i] = nodes_[node[i * beam]].leaf;
+    if (squared_distances == nullptr) continue;
+    // As NearestCentroidIndex::Search: ||x||^2 in double, plus the score.
+    double norm = 0.0;
+    for (std::size_t d = 0; d < dim; ++d) {
+      norm += static_cast<double>(x[i * dim + d]) * x[i * dim + d];
+    }
+    squared_distances[i] = std::max(0.0f, static_cast<float>(norm) + score[i * beam]);
   }
 }
 

@@ -30,6 +30,11 @@
 // bit-identical for any thread count (kmeans.h, nearest_centroid.h), so the
 // tree is too. Leaves are numbered in node order.
 //
+// Search. The plain descent misses the nearest leaf when a point lies near a
+// boundary of an upper level; keeping the `probes` nearest nodes at each level
+// (a beam) finds most of those, at about probes x depth x V^(1/depth)
+// distances.
+//
 // Layout. Nodes in one array, breadth first: a node's children are
 // consecutive. Each internal node holds an exact index over its children's
 // centres; Search() moves all points down one level at a time, bucketing them
@@ -52,8 +57,10 @@ class VocabularyTree {
  public:
   /// Sub-sample bound of an internal node's k-means, in points a child.
   static constexpr int kNodePointsPerCentroid = 256;
-  /// Bounds of the tree's shape.
-  static constexpr int kMaxDepth = 8;
+  /// Lloyd steps over the leaves after growing (see Method).
+  static constexpr int kRefinements = 2;
+  /// Most nodes a search keeps a level (KMeansOptions::tree_probes).
+  static constexpr uint32_t kMaxProbes = 64;
 
   /// One node: an internal node's children are nodes [first_child,
   /// first_child + num_children); a leaf has none and its word index.
@@ -80,13 +87,16 @@ class VocabularyTree {
   /// 0..V-1, a node that is neither, sizes, non-finite values).
   static absl::StatusOr<VocabularyTree> FromNodes(std::vector<Node> nodes,
                                                   std::vector<float> centres,
-                                                  std::size_t dim);
+                                                  std::size_t dim,
+                                                  uint32_t probes);
 
   /// Number of leaves V.
   std::size_t num_leaves() const { return leaf_node_.size(); }
   std::size_t dim() const { return dim_; }
   /// Levels below the root on the longest path.
   int depth() const { return depth_; }
+  /// Nodes the search keeps at each level (1: the plain descent).
+  uint32_t probes() const { return probes_; }
   const std::vector<Node>& nodes() const { return nodes_; }
   /// (nodes().size() - 1) x dim: node i's centre at row i - 1.
   const std::vector<float>& centres() const { return centres_; }
@@ -95,8 +105,10 @@ class VocabularyTree {
 
   /// For each of the `n` row-major points, its leaf (labels[i]) and, when
   /// `squared_distances` is not null, the squared distance to that leaf's
-  /// centre. Runs on up to `num_threads` threads (<= 0: all cores); the result
-  /// does not depend on it.
+  /// centre: the nearest leaf under the probes() nearest nodes kept at each
+  /// level (a beam search; ties to the lower node). With one probe it is the
+  /// descent that partitioned the training points. Runs on up to
+  /// `num_threads` threads (<= 0: all cores); the result does not depend on it.
   void Search(const uint8_t* points,
               std::size_t n,
               int num_threads,
@@ -105,12 +117,26 @@ class VocabularyTree {
 
  private:
   VocabularyTree() = default;
+  // Points are searched in blocks of this many (the unit of parallelism).
+  static constexpr std::size_t kPointsPerBlock = 4096;
   // Builds the children's indexes, leaf_node_ and depth_ from nodes_ and
   // centres_ (already checked).
   void Index();
+  // Hierarchical k-means over `train` (dim_ bytes a point): nodes_,
+  // centres_, the leaves' numbers and the indexes.
+  absl::Status Grow(const std::vector<uint8_t>& train, const KMeansOptions& options);
+  // `iterations` Lloyd steps over the leaves, each point assigned by
+  // Search(); returns the mean squared distance of each assignment
+  // (iterations + 1 values: after growing, after each step).
+  std::vector<double> Refine(const std::vector<uint8_t>& train, int iterations, int num_threads);
+  void SearchBlock(const uint8_t* points,
+                   std::size_t count,
+                   uint32_t* labels,
+                   float* squared_distances) const;
 
   std::size_t dim_ = 0;
   int depth_ = 0;
+  uint32_t probes_ = 1;
   std::vector<Node> nodes_;
   std::vector<float> centres_;
   // Per node: an index over its children's centres (empty for a leaf).

@@ -89,6 +89,34 @@ TEST(VocabularyTreeTest, SearchIsTheDescentAndTrainingPointsUseEveryLeaf) {
   EXPECT_EQ(std::set<uint32_t>(labels.begin(), labels.end()).size(), 400u);
 }
 
+TEST(VocabularyTreeTest, MoreProbesFindTheNearestLeafMoreOften) {
+  const std::vector<uint8_t> points = Points(20000, 9);
+  KMeansOptions options = TreeOptions(400, 3);
+  std::vector<double> agreement;
+  for (int probes : {1, 2, 8}) {
+    options.tree_probes = probes;
+    auto tree = VocabularyTree::Train(points.data(), 20000, kDim, options);
+    ASSERT_TRUE(tree.ok()) << tree.status();
+    EXPECT_EQ(tree->probes(), static_cast<uint32_t>(probes));
+    const std::vector<float> leaves = tree->LeafCentres();
+    std::vector<uint32_t> exact(5000), found(5000);
+    std::vector<float> exact_d(5000), found_d(5000);
+    NearestCentroidIndex(leaves.data(), 400, kDim)
+        .Search(points.data(), 5000, 1, exact.data(), exact_d.data());
+    tree->Search(points.data(), 5000, 1, found.data(), found_d.data());
+    std::size_t same = 0;
+    for (std::size_t i = 0; i < 5000; ++i) {
+      same += exact[i] == found[i];
+      EXPECT_GE(found_d[i], exact_d[i] * (1 - 1e-5f) - 1e-3f);
+    }
+    agreement.push_back(same / 5000.0);
+  }
+  // The same tree each time (probes do not change training), searched wider.
+  EXPECT_LT(agreement[0], agreement[1]);
+  EXPECT_LE(agreement[1], agreement[2]);
+  EXPECT_GT(agreement[2], 0.97);
+}
+
 TEST(VocabularyTreeTest, BitIdenticalForAnyThreadCountAndSeeded) {
   const std::vector<uint8_t> points = Points(15000, 3);
   KMeansOptions one = TreeOptions(300, 2);
@@ -111,13 +139,16 @@ TEST(VocabularyTreeTest, BitIdenticalForAnyThreadCountAndSeeded) {
 
 TEST(VocabularyTreeTest, CodebookRoundTripsTheTreeAndEncodesAsItDid) {
   const std::vector<uint8_t> points = Points(12000, 4);
-  auto codebook = Codebook::Train(points.data(), 12000, kDim, TreeOptions(250, 3));
+  KMeansOptions options = TreeOptions(250, 3);
+  options.tree_probes = 3;
+  auto codebook = Codebook::Train(points.data(), 12000, kDim, options);
   ASSERT_TRUE(codebook.ok()) << codebook.status();
   ASSERT_NE(codebook->tree(), nullptr);
   EXPECT_EQ(codebook->size(), 250u);
   auto back = Codebook::Deserialize(codebook->Serialize());
   ASSERT_TRUE(back.ok()) << back.status();
   ASSERT_NE(back->tree(), nullptr);
+  EXPECT_EQ(back->tree()->probes(), 3u);
   EXPECT_EQ(back->centroids(), codebook->centroids());
   EXPECT_EQ(back->Serialize(), codebook->Serialize());
   EXPECT_EQ(*back->NearestCentroids(points.data(), 12000),
@@ -141,14 +172,14 @@ TEST(VocabularyTreeTest, DeserializeRejectsAnInconsistentTree) {
   std::vector<float> centres = codebook->tree()->centres();
   auto broken = nodes;
   broken[0].first_child = 2;
-  EXPECT_FALSE(VocabularyTree::FromNodes(broken, centres, kDim).ok());
+  EXPECT_FALSE(VocabularyTree::FromNodes(broken, centres, kDim, 1).ok());
   broken = nodes;
   for (auto& node : broken) {
     if (node.num_children == 0) node.leaf = 0;
   }
-  EXPECT_FALSE(VocabularyTree::FromNodes(broken, centres, kDim).ok());
+  EXPECT_FALSE(VocabularyTree::FromNodes(broken, centres, kDim, 1).ok());
   centres.pop_back();
-  EXPECT_FALSE(VocabularyTree::FromNodes(nodes, centres, kDim).ok());
+  EXPECT_FALSE(VocabularyTree::FromNodes(nodes, centres, kDim, 1).ok());
 }
 
 TEST(VocabularyTreeTest, OptionsAreValidated) {

@@ -298,6 +298,8 @@ std::vector<ParamSpec> RankingRows() {
     Param("kmeans_tree_depth", Range(1, 8), kBagOfFeatures, OF(o.kmeans.tree_depth),
           "levels of the vocabulary tree (kmeans_assignment=tree): about depth x V^(1/depth) "
           "distances a descriptor"),
+    Param("kmeans_tree_probes", Range(1, 64), kBagOfFeatures, OF(o.kmeans.tree_probes),
+          "nodes the vocabulary tree's search keeps at each level (1: the plain descent)"),
     Param("seed", Range(0, kMaxSeed), kBagOfFeatures, OF(o.kmeans.seed),
           "seed of k-means sampling and seeding"),
     Param("idf", Range(0, 1), kBagOfFeatures, OF(o.weighting.idf),

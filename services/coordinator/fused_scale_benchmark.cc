@@ -114,18 +114,15 @@ IndexSignature Signature(std::mt19937_64& rng, const RetrievalPipelineOptions& m
   return s;
 }
 
-int Run(const flags::ParamFlags& params) {
-  absl::StatusOr<CollectionOptions> options = flags::CollectionOptionsFromFlags(params);
-  if (!options.ok() || !options->rescaled()) {
-    std::fprintf(stderr, "--method must name a fused or re-ranked collection\n");
-    return 2;
-  }
-  const int n = absl::GetFlag(FLAGS_models);
-  std::string work = absl::GetFlag(FLAGS_work_dir);
-  if (work.empty()) work = std::filesystem::temp_directory_path() / absl::StrCat("fused-scale-", getpid());
-  // The index servers.
-  std::vector<pid_t> servers;
+struct IndexServers {
+  std::vector<pid_t> pids;
   std::vector<std::string> targets;
+};
+
+// --shards meshseek-index processes, each on a free port with its folder
+// under `work`, its log in the folder.
+IndexServers StartIndexServers(const std::string& work) {
+  IndexServers servers;
   for (int s = 0; s < absl::GetFlag(FLAGS_shards); ++s) {
     const int port = rpc::FreeLoopbackPort();
     const std::string dir = absl::StrCat(work, "/index-", s);
@@ -134,75 +131,80 @@ int Run(const flags::ParamFlags& params) {
     if (pid == 0) {
       const std::string log = dir + "/log";
       freopen(log.c_str(), "w", stderr);
+      const std::string postings =
+          absl::StrCat("--postings_max_models=", absl::GetFlag(FLAGS_postings_max_models));
       execl(MESHSEEK_INDEX_PATH, MESHSEEK_INDEX_PATH, absl::StrCat("--port=", port).c_str(),
-            absl::StrCat("--data_dir=", dir).c_str(),
-            absl::StrCat("--postings_max_models=", absl::GetFlag(FLAGS_postings_max_models)).c_str(),
-            static_cast<char*>(nullptr));
+            absl::StrCat("--data_dir=", dir).c_str(), postings.c_str(), static_cast<char*>(nullptr));
       _exit(127);
     }
-    servers.push_back(pid);
-    targets.push_back(absl::StrCat("127.0.0.1:", port));
+    servers.pids.push_back(pid);
+    servers.targets.push_back(absl::StrCat("127.0.0.1:", port));
   }
-  const std::atomic<bool> stop{false};
-  IndexShards index(targets, rpc::ChannelOptions{}, absl::Minutes(10), rpc::RetryOptions{}, &stop);
+  return servers;
+}
+
+// Peak memory and disk of each server; then stops it.
+void ReportAndStop(const IndexServers& servers, const std::string& work, int n) {
+  for (std::size_t s = 0; s < servers.pids.size(); ++s) {
+    uint64_t disk = 0;
+    std::error_code ec;
+    for (const auto& f : std::filesystem::recursive_directory_iterator(
+             absl::StrCat(work, "/index-", s), ec)) {
+      if (f.is_regular_file()) disk += f.file_size();
+    }
+    std::printf("index shard %zu: peak RSS %.0f MB, %.1f KB a model on disk\n", s,
+                PeakMb(servers.pids[s]), disk / 1024.0 / n);
+    kill(servers.pids[s], SIGTERM);
+    waitpid(servers.pids[s], nullptr, 0);
+  }
+}
+
+// The coordinator's view of the fused collection "scale": one part a member.
+CollectionPlan ScalePlan(const CollectionOptions& options) {
   CollectionPlan plan;
   plan.name = "scale";
-  plan.options = *options;
-  for (const RetrievalPipelineOptions& method : options->methods) {
+  plan.options = options;
+  for (const RetrievalPipelineOptions& method : options.methods) {
     CollectionInfo part;
     part.name = MemberCollectionName(plan.name, method.extractor.method);
     part.options = method;
     plan.parts.push_back(part);
   }
-  // Model i's signatures (seeded by i), added to every part.
-  const auto add_model = [&](std::size_t i, std::vector<IndexSignature>* kept) -> absl::Status {
-    std::mt19937_64 rng(i + 1);
-    for (const CollectionInfo& part : plan.parts) {
-      IndexSignature s = Signature(rng, part.options);
-      v1::AddModelRequest add;
-      add.set_collection(part.name);
-      add.set_model_id(absl::StrCat("m", i));
-      add.set_ordinal(i);
-      add.set_label(absl::StrCat("c", i % 50));
-      if (s.descriptor.has_value()) {
-        *add.mutable_global_descriptor() = *s.descriptor;
-      } else {
-        *add.mutable_histogram() = s.histogram;
-      }
-      MESHSEEK_RETURN_IF_ERROR(index.Add(add));
-      if (kept != nullptr) kept->push_back(std::move(s));
+  return plan;
+}
+
+// Model i's signatures (seeded by i), added to every part; kept when asked.
+absl::Status AddModel(IndexShards* index,
+                      const CollectionPlan& plan,
+                      std::size_t i,
+                      std::vector<IndexSignature>* kept) {
+  std::mt19937_64 rng(i + 1);
+  for (const CollectionInfo& part : plan.parts) {
+    IndexSignature s = Signature(rng, part.options);
+    v1::AddModelRequest add;
+    add.set_collection(part.name);
+    add.set_model_id(absl::StrCat("m", i));
+    add.set_ordinal(i);
+    add.set_label(absl::StrCat("c", i % 50));
+    if (s.descriptor.has_value()) {
+      *add.mutable_global_descriptor() = *s.descriptor;
+    } else {
+      *add.mutable_histogram() = s.histogram;
     }
-    return absl::OkStatus();
-  };
-  // 1. Adds, several in flight (the first waits for the servers to start).
-  auto start = std::chrono::steady_clock::now();
-  std::vector<absl::Status> errors(n);
-  ParallelFor(static_cast<std::size_t>(n), 8,
-              [&](std::size_t i) { errors[i] = add_model(i, nullptr); });
-  for (const absl::Status& e : errors) {
-    if (!e.ok()) {
-      std::fprintf(stderr, "add: %s\n", e.ToString().c_str());
-      return 1;
-    }
+    MESHSEEK_RETURN_IF_ERROR(index->Add(add));
+    if (kept != nullptr) kept->push_back(std::move(s));
   }
-  std::printf("%d models, %s, %zu index shard(s): added in %.1f s\n", n,
-              options->MethodName().c_str(), targets.size(), Seconds(start));
-  // 2. The ranking state.
-  RankingGraphOptions graph;
-  graph.exact_graph_models = static_cast<std::size_t>(absl::GetFlag(FLAGS_exact_graph_models));
-  graph.graph_candidates = absl::GetFlag(FLAGS_graph_candidates);
-  start = std::chrono::steady_clock::now();
-  absl::StatusOr<RankingState> state = ComputeRankingState(&index, plan, graph);
-  if (!state.ok()) {
-    std::fprintf(stderr, "ranking state: %s\n", state.status().ToString().c_str());
-    return 1;
-  }
-  std::printf("ranking state (%s graph, %u candidates a method): %.1f s, %zu bytes\n",
-              static_cast<std::size_t>(n) > graph.exact_graph_models ? "approximate" : "exact",
-              graph.graph_candidates, Seconds(start), state->Serialize().size());
-  absl::StatusOr<Ranking> ranking = Ranking::Make("bench", *std::move(state), plan.options);
-  if (!ranking.ok()) return 1;
-  // 3. Fused queries: new signatures, exact and with candidates.
+  return absl::OkStatus();
+}
+
+std::vector<const IndexSignature*> Pointers(const std::vector<IndexSignature>& signatures) {
+  std::vector<const IndexSignature*> out;
+  for (const IndexSignature& s : signatures) out.push_back(&s);
+  return out;
+}
+
+// Step 3: fused queries of new signatures, exact and with candidates.
+absl::Status TimeQueries(IndexShards* index, const CollectionPlan& plan, const Ranking& ranking) {
   std::mt19937_64 rng(0xfeed);
   std::vector<std::vector<IndexSignature>> queries(absl::GetFlag(FLAGS_queries));
   for (auto& q : queries) {
@@ -214,42 +216,48 @@ int Run(const flags::ParamFlags& params) {
         candidates == 0 ? std::min<std::size_t>(queries.size(), absl::GetFlag(FLAGS_exact_queries))
                         : queries.size();
     for (std::size_t k = 0; k < asked; ++k) {
-      const auto& q = queries[k];
-      std::vector<const IndexSignature*> signatures;
-      for (const IndexSignature& s : q) signatures.push_back(&s);
+      const std::vector<const IndexSignature*> signatures = Pointers(queries[k]);
       const auto t = std::chrono::steady_clock::now();
-      auto distances = candidates == 0 ? PartDistances(&index, plan, signatures)
-                                       : CandidatePartDistances(&index, plan, signatures, candidates);
-      if (!distances.ok()) return 1;
-      auto found = ranking->Query(*distances, plan.options, 10);
-      if (!found.ok()) return 1;
+      auto distances = candidates == 0
+                           ? PartDistances(index, plan, signatures)
+                           : CandidatePartDistances(index, plan, signatures, candidates);
+      MESHSEEK_RETURN_IF_ERROR(distances.status());
+      MESHSEEK_RETURN_IF_ERROR(ranking.Query(*distances, plan.options, 10).status());
       ms.push_back(Seconds(t) * 1e3);
     }
     std::printf("fused query, search part, %s: %s\n",
                 candidates == 0 ? "exact" : absl::StrCat(candidates, " candidates").c_str(),
                 Percentiles(ms).c_str());
   }
-  // 4. Live ingest: a model added after the build (its extraction done),
-  //    joined from candidates as the coordinator's live index does, until a
-  //    query with its signatures returns it first.
+  return absl::OkStatus();
+}
+
+// Step 4: a model added after the build (its extraction done), joined from
+// candidates as the coordinator's live index does, until a query with its
+// signatures returns it first.
+absl::Status TimeLiveIngest(IndexShards* index,
+                            const CollectionPlan& plan,
+                            uint32_t graph_candidates,
+                            int n,
+                            Ranking* ranking) {
   std::vector<double> live_ms;
   for (int l = 0; l < absl::GetFlag(FLAGS_live_models); ++l) {
     const std::size_t i = static_cast<std::size_t>(n) + l;
     const auto t = std::chrono::steady_clock::now();
     std::vector<IndexSignature> own;
-    if (!add_model(i, &own).ok()) return 1;
-    std::vector<const IndexSignature*> signatures;
-    for (const IndexSignature& s : own) signatures.push_back(&s);
-    auto distances = CandidatePartDistances(&index, plan, signatures, graph.graph_candidates);
-    if (!distances.ok()) return 1;
-    auto join = ranking->PlanJoin(absl::StrCat("m", i), i, "", *distances);
-    if (!join.ok() || !ranking->Apply(*join).ok()) return 1;
-    auto asked = CandidatePartDistances(&index, plan, signatures, absl::GetFlag(FLAGS_candidates));
-    if (!asked.ok()) return 1;
-    auto found = ranking->Query(*asked, plan.options, 10);
-    if (!found.ok() || found->empty() || (*found)[0].model_id() != absl::StrCat("m", i)) {
-      std::fprintf(stderr, "live model m%zu not returned first\n", i);
-      return 1;
+    MESHSEEK_RETURN_IF_ERROR(AddModel(index, plan, i, &own));
+    const std::vector<const IndexSignature*> signatures = Pointers(own);
+    MESHSEEK_ASSIGN_OR_RETURN(auto distances,
+                              CandidatePartDistances(index, plan, signatures, graph_candidates));
+    MESHSEEK_ASSIGN_OR_RETURN(auto join,
+                              ranking->PlanJoin(absl::StrCat("m", i), i, "", distances));
+    MESHSEEK_RETURN_IF_ERROR(ranking->Apply(join));
+    MESHSEEK_ASSIGN_OR_RETURN(
+        auto asked,
+        CandidatePartDistances(index, plan, signatures, absl::GetFlag(FLAGS_candidates)));
+    MESHSEEK_ASSIGN_OR_RETURN(auto found, ranking->Query(asked, plan.options, 10));
+    if (found.empty() || found[0].model_id() != absl::StrCat("m", i)) {
+      return absl::InternalError(absl::StrCat("live model m", i, " not returned first"));
     }
     live_ms.push_back(Seconds(t) * 1e3);
   }
@@ -257,22 +265,56 @@ int Run(const flags::ParamFlags& params) {
     std::printf("live ingest, added to every part until a query returns it: %s\n",
                 Percentiles(live_ms).c_str());
   }
-  for (std::size_t s = 0; s < servers.size(); ++s) {
-    uint64_t disk = 0;
-    std::error_code ec;
-    for (const auto& f : std::filesystem::recursive_directory_iterator(
-             absl::StrCat(work, "/index-", s), ec)) {
-      if (f.is_regular_file()) disk += f.file_size();
-    }
-    std::printf("index shard %zu: peak RSS %.0f MB, %.1f KB a model on disk\n", s,
-                PeakMb(servers[s]), disk / 1024.0 / n);
-    kill(servers[s], SIGTERM);
-    waitpid(servers[s], nullptr, 0);
+  return absl::OkStatus();
+}
+
+absl::Status Run(const CollectionOptions& options, const IndexServers& servers, int n) {
+  const std::atomic<bool> stop{false};
+  IndexShards index(servers.targets, rpc::ChannelOptions{}, absl::Minutes(10), rpc::RetryOptions{},
+                    &stop);
+  const CollectionPlan plan = ScalePlan(options);
+  // 1. Adds, several in flight (the first waits for the servers to start).
+  auto start = std::chrono::steady_clock::now();
+  std::vector<absl::Status> errors(n);
+  ParallelFor(static_cast<std::size_t>(n), 8,
+              [&](std::size_t i) { errors[i] = AddModel(&index, plan, i, nullptr); });
+  for (const absl::Status& e : errors) MESHSEEK_RETURN_IF_ERROR(e);
+  std::printf("%d models, %s, %zu index shard(s): added in %.1f s\n", n,
+              options.MethodName().c_str(), servers.targets.size(), Seconds(start));
+  // 2. The ranking state.
+  RankingGraphOptions graph;
+  graph.exact_graph_models = static_cast<std::size_t>(absl::GetFlag(FLAGS_exact_graph_models));
+  graph.graph_candidates = absl::GetFlag(FLAGS_graph_candidates);
+  start = std::chrono::steady_clock::now();
+  MESHSEEK_ASSIGN_OR_RETURN(RankingState state, ComputeRankingState(&index, plan, graph));
+  std::printf("ranking state (%s graph, %u candidates a method): %.1f s, %zu bytes\n",
+              static_cast<std::size_t>(n) > graph.exact_graph_models ? "approximate" : "exact",
+              graph.graph_candidates, Seconds(start), state.Serialize().size());
+  MESHSEEK_ASSIGN_OR_RETURN(Ranking ranking,
+                            Ranking::Make("bench", std::move(state), plan.options));
+  MESHSEEK_RETURN_IF_ERROR(TimeQueries(&index, plan, ranking));
+  return TimeLiveIngest(&index, plan, graph.graph_candidates, n, &ranking);
+}
+
+int Run(const flags::ParamFlags& params) {
+  absl::StatusOr<CollectionOptions> options = flags::CollectionOptionsFromFlags(params);
+  if (!options.ok() || !options->rescaled()) {
+    std::fprintf(stderr, "--method must name a fused or re-ranked collection\n");
+    return 2;
   }
+  const int n = absl::GetFlag(FLAGS_models);
+  std::string work = absl::GetFlag(FLAGS_work_dir);
+  if (work.empty()) {
+    work = std::filesystem::temp_directory_path() / absl::StrCat("fused-scale-", getpid());
+  }
+  const IndexServers servers = StartIndexServers(work);
+  const absl::Status run = Run(*options, servers, n);
+  if (!run.ok()) std::fprintf(stderr, "fused_scale_benchmark: %s\n", run.ToString().c_str());
+  ReportAndStop(servers, work, n);
   std::printf("this process (the coordinator's code): peak RSS %.0f MB\n", PeakMb(0));
   std::error_code ec;
   if (absl::GetFlag(FLAGS_work_dir).empty()) std::filesystem::remove_all(work, ec);
-  return 0;
+  return run.ok() ? 0 : 1;
 }
 
 }  // namespace

@@ -177,28 +177,18 @@ absl::Status WaitFor(v1::Coordinator::Stub* stub, const std::string& job_id) {
   }
 }
 
-absl::Status Run(const flags::ParamFlags& params) {
-  std::string data_dir = absl::GetFlag(FLAGS_data_dir);
-  const bool temporary = data_dir.empty();
-  if (temporary) {
-    data_dir = (std::filesystem::temp_directory_path() /
-                absl::StrCat("meshseek-load-", getpid())).string();
-  }
-  SyntheticBenchmarkOptions synth;
-  synth.models_per_class = absl::GetFlag(FLAGS_models_per_class);
-  MESHSEEK_RETURN_IF_ERROR(GenerateSyntheticBenchmark(synth, data_dir + "/bench"));
-  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<Model> models, LoadModels(data_dir + "/bench"));
-  MESHSEEK_ASSIGN_OR_RETURN(auto stack,
-                            EmbeddedStack::Start(data_dir + "/stack", params.threads));
-  auto setup = Connect(stack->coordinator_address());
+// Set-up: the queried collection "load" ingested and built, and an empty
+// "load-ingest" for the ingest clients.
+absl::Status SetUp(v1::Coordinator::Stub* setup,
+                   const std::vector<Model>& models,
+                   const flags::ParamFlags& params) {
+  const absl::Time start = absl::Now();
   const absl::Duration deadline = absl::GetFlag(FLAGS_call_deadline);
-
-  // Set-up: the queried collection, ingested and built.
-  absl::Time start = absl::Now();
-  MESHSEEK_RETURN_IF_ERROR(CreateCollection(setup.get(), "load", params));
-  MESHSEEK_RETURN_IF_ERROR(CreateCollection(setup.get(), "load-ingest", params));
+  MESHSEEK_RETURN_IF_ERROR(CreateCollection(setup, "load", params));
+  MESHSEEK_RETURN_IF_ERROR(CreateCollection(setup, "load-ingest", params));
   for (const Model& m : models) {
-    MESHSEEK_RETURN_IF_ERROR(rpc::FromGrpcStatus(IngestOne(setup.get(), "load", m.entry.id, m, deadline)));
+    MESHSEEK_RETURN_IF_ERROR(
+        rpc::FromGrpcStatus(IngestOne(setup, "load", m.entry.id, m, deadline)));
   }
   for (uint64_t done = 0; done < models.size();) {
     absl::SleepFor(absl::Milliseconds(200));
@@ -210,27 +200,30 @@ absl::Status Run(const flags::ParamFlags& params) {
     MESHSEEK_RETURN_IF_ERROR(rpc::FromGrpcStatus(setup->GetCollection(&context, request, &info)));
     done = info.extracted();
   }
-  {
-    grpc::ClientContext context;
-    rpc::SetDeadline(&context, absl::Minutes(1));
-    v1::BuildRequest request;
-    request.set_collection("load");
-    v1::JobStatus job;
-    MESHSEEK_RETURN_IF_ERROR(rpc::FromGrpcStatus(setup->Build(&context, request, &job)));
-    MESHSEEK_RETURN_IF_ERROR(WaitFor(setup.get(), job.job_id()));
-  }
+  grpc::ClientContext context;
+  rpc::SetDeadline(&context, absl::Minutes(1));
+  v1::BuildRequest request;
+  request.set_collection("load");
+  v1::JobStatus job;
+  MESHSEEK_RETURN_IF_ERROR(rpc::FromGrpcStatus(setup->Build(&context, request, &job)));
+  MESHSEEK_RETURN_IF_ERROR(WaitFor(setup, job.job_id()));
   std::printf("set-up: %zu synthetic models ingested and built in %.1f s\n", models.size(),
               absl::ToDoubleSeconds(absl::Now() - start));
+  return absl::OkStatus();
+}
 
+// The load: query and ingest clients for --duration; the calls failed.
+int Load(const std::string& address, const std::vector<Model>& models) {
+  const absl::Duration deadline = absl::GetFlag(FLAGS_call_deadline);
   const int query_clients = absl::GetFlag(FLAGS_query_clients);
   const int ingest_clients = absl::GetFlag(FLAGS_ingest_clients);
   Tally query_mesh, query_file, ingest;
   std::atomic<bool> stop{false};
   std::vector<std::thread> clients;
-  start = absl::Now();
+  const absl::Time start = absl::Now();
   for (int c = 0; c < query_clients; ++c) {
     clients.emplace_back([&, c] {
-      auto stub = Connect(stack->coordinator_address());
+      auto stub = Connect(address);
       for (std::size_t i = c; !stop.load(); i += query_clients) {
         const Model& m = models[i % models.size()];
         const bool as_file = (i / query_clients) % 2 == 1;
@@ -249,7 +242,7 @@ absl::Status Run(const flags::ParamFlags& params) {
   }
   for (int c = 0; c < ingest_clients; ++c) {
     clients.emplace_back([&, c] {
-      auto stub = Connect(stack->coordinator_address());
+      auto stub = Connect(address);
       for (int n = 0; !stop.load(); ++n) {
         const Model& m = models[(c + n * ingest_clients) % models.size()];
         const absl::Time t = absl::Now();
@@ -269,7 +262,26 @@ absl::Status Run(const flags::ParamFlags& params) {
   int errors = query_mesh.Print("query", elapsed);
   errors += query_file.Print("query-f", elapsed);
   errors += ingest.Print("ingest", elapsed);
-  std::printf("(query: mesh as arrays; query-f: as MeshFile bytes; ingest: ack of one model per stream)\n");
+  std::printf("(query: mesh as arrays; query-f: as MeshFile bytes; ingest: ack of one model per "
+              "stream)\n");
+  return errors;
+}
+
+absl::Status Run(const flags::ParamFlags& params) {
+  std::string data_dir = absl::GetFlag(FLAGS_data_dir);
+  const bool temporary = data_dir.empty();
+  if (temporary) {
+    data_dir = (std::filesystem::temp_directory_path() /
+                absl::StrCat("meshseek-load-", getpid())).string();
+  }
+  SyntheticBenchmarkOptions synth;
+  synth.models_per_class = absl::GetFlag(FLAGS_models_per_class);
+  MESHSEEK_RETURN_IF_ERROR(GenerateSyntheticBenchmark(synth, data_dir + "/bench"));
+  MESHSEEK_ASSIGN_OR_RETURN(const std::vector<Model> models, LoadModels(data_dir + "/bench"));
+  MESHSEEK_ASSIGN_OR_RETURN(auto stack,
+                            EmbeddedStack::Start(data_dir + "/stack", params.threads));
+  MESHSEEK_RETURN_IF_ERROR(SetUp(Connect(stack->coordinator_address()).get(), models, params));
+  const int errors = Load(stack->coordinator_address(), models);
   stack.reset();
   if (temporary) std::filesystem::remove_all(data_dir);
   if (errors > 0) return absl::InternalError(absl::StrCat(errors, " calls failed"));
