@@ -106,6 +106,16 @@ absl::StatusOr<VocabularyTree> VocabularyTree::Train(const uint8_t* points,
         absl::StrCat("vocabulary tree: got ", n, " training points for ", leaves, " leaves"));
   }
   if (points == nullptr) return absl::InvalidArgumentError("vocabulary tree: points is null");
+  // The sample sent in place of the set must be the one KMeansTrainingRows
+  // draws from it, as TrainKMeans checks.
+  const std::size_t max_train =
+      static_cast<std::size_t>(leaves) * static_cast<std::size_t>(options.max_points_per_centroid);
+  if (options.sampled_from > 0 && (options.sampled_from <= max_train || n != max_train)) {
+    const uint64_t want = std::min<uint64_t>(options.sampled_from, max_train);
+    return absl::InvalidArgumentError(absl::StrCat("vocabulary tree: ", n, " points sampled from ",
+                                                   options.sampled_from, "; a sample of it has ",
+                                                   want, " points"));
+  }
   const absl::Time start = absl::Now();
 
   // The flat vocabulary's sample (kmeans.h step 1), made contiguous.
@@ -173,7 +183,8 @@ absl::Status VocabularyTree::Grow(const std::vector<uint8_t>& train, const KMean
     node.min_points_per_centroid = 1;
     // The last level trains on all its points: its centres are words.
     const int all_points = static_cast<int>((at.rows.size() + k - 1) / k);
-    node.max_points_per_centroid = std::max(1, at.levels == 1 ? all_points : kNodePointsPerCentroid);
+    node.max_points_per_centroid =
+        std::max(1, at.levels == 1 ? all_points : kNodePointsPerCentroid);
     MESHSEEK_ASSIGN_OR_RETURN(
         std::vector<float> centres,
         internal::TrainKMeansQuietly(node_points.data(), at.rows.size(), dim, node, nullptr));

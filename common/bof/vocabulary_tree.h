@@ -16,14 +16,16 @@
 // flat vocabulary. A node that is to hold t leaves at d levels above the
 // leaves is split by exact k-means into k = round(t^(1/d)) children (k = t
 // at the last level), and its t leaves are shared among the children in
-// proportion to the points each child received (largest remainders; at least
-// one each, at most a child's points), so that leaves hold about as many
+// proportion to the points each child received (one at a time to the child
+// furthest below its share; at least one each, at most a child's points), so
+// that leaves hold about as many
 // points as a flat vocabulary's words and the tree has exactly V leaves. A
 // child with one leaf is a leaf. Internal nodes' k-means runs on at most
 // kNodePointsPerCentroid points a child (its centres need few); a last-level
-// node's on all of its points. Every point is then assigned to its nearest
-// child exactly, so the tree's partition of the training set is the one
-// Search() makes.
+// node's on all of its points; every point then goes down to its nearest
+// child. Last, kRefinements Lloyd steps over the leaves: every training point
+// to its leaf by Search() (with the tree's probes), each leaf's centre to the
+// mean of its points; the inner nodes stay as grown.
 //
 // Determinism. Nodes are numbered breadth first; node i's k-means is seeded
 // with a function of the options' seed and i, and every k-means and search is

@@ -182,6 +182,25 @@ TEST(VocabularyTreeTest, DeserializeRejectsAnInconsistentTree) {
   EXPECT_FALSE(VocabularyTree::FromNodes(nodes, centres, kDim, 1).ok());
 }
 
+TEST(VocabularyTreeTest, TheSampleAloneGivesTheWholeSetsTree) {
+  const std::vector<uint8_t> points = Points(30000, 10);
+  KMeansOptions options = TreeOptions(200, 2);
+  options.max_points_per_centroid = 50;  // a sample of 10,000 of the 30,000
+  auto whole = VocabularyTree::Train(points.data(), 30000, kDim, options);
+  ASSERT_TRUE(whole.ok()) << whole.status();
+  std::vector<uint8_t> sample;
+  for (std::size_t row : KMeansTrainingRows(30000, options)) {
+    sample.insert(sample.end(), &points[row * kDim], &points[(row + 1) * kDim]);
+  }
+  KMeansOptions sent = options;
+  sent.sampled_from = 30000;
+  auto part = VocabularyTree::Train(sample.data(), sample.size() / kDim, kDim, sent);
+  ASSERT_TRUE(part.ok()) << part.status();
+  EXPECT_EQ(part->centres(), whole->centres());
+  // A sample of another size is refused.
+  EXPECT_FALSE(VocabularyTree::Train(sample.data(), sample.size() / kDim - 1, kDim, sent).ok());
+}
+
 TEST(VocabularyTreeTest, OptionsAreValidated) {
   const std::vector<uint8_t> points = Points(1000, 6);
   KMeansOptions options = TreeOptions(100, 0);
