@@ -16,12 +16,58 @@ set(MESHSEEK_TEST_TIMEOUT_SCALE 1 CACHE STRING
     "Factor on every test's timeout (scripts/sanitize.sh sets it per sanitizer)")
 
 # Compile options of the tests' own sources only (not of the code they test).
-# The sanitizer builds set -O0: a test's source is mostly GoogleTest macros,
-# whose instrumented code gcc optimises slowly (a unit test 12 s at -O2, 5 s at
-# -O0 under ASan + UBSan), while the work it calls runs in the libraries,
-# optimised as before.
-set(MESHSEEK_TEST_COMPILE_OPTIONS "" CACHE STRING
-    "Compile options of the test sources (scripts/sanitize.sh: -O0)")
+# A test's source is mostly GoogleTest macros, whose code gcc optimises slowly
+# while the work it calls runs in the libraries, optimised as the build says:
+# the release build compiles tests at -O1 (class_file_test 10.5 s at -O3,
+# 4.8 s at -O1; 440 of a cold build's 1,110 CPU seconds were tests at -O3),
+# the sanitizer builds at -O0 (scripts/sanitize.sh; a unit test 12 s at -O2,
+# 5 s at -O0 under ASan + UBSan).
+set(MESHSEEK_TEST_COMPILE_OPTIONS "-O1" CACHE STRING
+    "Compile options of the test sources (release -O1; scripts/sanitize.sh: -O0)")
+
+# Compile options of the code protoc and its gRPC plugin generate
+# (proto/CMakeLists.txt). The sanitizer builds set -fno-sanitize=all: the
+# generated code is not ours, the protobuf and gRPC runtimes it calls are
+# Debian's uninstrumented libraries anyway, and instrumented it took 224 of
+# the ASan build's CPU seconds against 83 uninstrumented. The fuzz build
+# keeps it instrumented (its harnesses parse messages in that code).
+set(MESHSEEK_GENERATED_COMPILE_OPTIONS "" CACHE STRING
+    "Compile options of the generated protobuf/gRPC code (scripts/sanitize.sh: -fno-sanitize=all)")
+
+# The headers nearly every test parses, precompiled once a build (with the
+# tests' options, by meshseek_test_main) and used by every test: parsing them
+# was ~3 of a test's 5 to 9 seconds of compilation (class_file_test at -O1:
+# 8.5 s without, 5.5 s with). Only headers that need no library beyond the
+# test main's (GoogleTest, OpenCV's core, Abseil's status and strings): a
+# header with static initialisers (gRPC's) would tie every test to its library.
+# gcc checks a precompiled header against each compilation's macros and
+# options and parses the headers as text where it does not match
+# (-Winvalid-pch says so), so it can make a build slower, never wrong.
+set(MESHSEEK_TEST_PRECOMPILED_HEADERS
+    <gtest/gtest.h> <gmock/gmock.h> <opencv2/core.hpp>
+    <algorithm> <cmath> <cstdint> <filesystem> <fstream> <limits> <map> <memory>
+    <random> <set> <sstream> <string> <vector>
+    [["absl/status/status.h"]] [["absl/status/statusor.h"]] [["absl/strings/str_cat.h"]]
+    [["absl/strings/string_view.h"]])
+
+# The headers of the RPC edge (gRPC, protobuf, the generated services),
+# precompiled once a build by meshseek_rpc and used by the services and the
+# CLI (meshseek_use_rpc_precompiled_header): they were most of those files'
+# compilation (the coordinator's 20-line main.cc 7.3 s, ranking.cc 14.7 s
+# without, 7.4 s with, under load).
+set(MESHSEEK_RPC_PRECOMPILED_HEADERS
+    <grpcpp/grpcpp.h> <google/protobuf/message.h>
+    [["meshseek/v1/codebook.grpc.pb.h"]] [["meshseek/v1/coordinator.grpc.pb.h"]]
+    [["meshseek/v1/extract.grpc.pb.h"]] [["meshseek/v1/index.grpc.pb.h"]]
+    [["meshseek/v1/resample.grpc.pb.h"]]
+    <algorithm> <cmath> <cstdint> <functional> <map> <memory> <string> <vector>
+    [["absl/container/flat_hash_map.h"]] [["absl/status/statusor.h"]]
+    [["absl/strings/str_cat.h"]] [["absl/synchronization/mutex.h"]])
+
+# Compiles a target that links meshseek::rpc with its precompiled header.
+function(meshseek_use_rpc_precompiled_header target)
+  target_precompile_headers(${target} REUSE_FROM meshseek_rpc)
+endfunction()
 
 function(meshseek_add_library)
   cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
@@ -55,6 +101,7 @@ function(meshseek_add_test)
   add_executable(${target} ${ARG_NAME}_test.cc ${ARG_SRCS})
   target_link_libraries(${target} PRIVATE ${ARG_DEPS} meshseek::test_main)
   target_compile_options(${target} PRIVATE ${MESHSEEK_TEST_COMPILE_OPTIONS})
+  target_precompile_headers(${target} REUSE_FROM meshseek_test_main)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 60)
   endif()
