@@ -55,6 +55,9 @@ ABSL_FLAG(std::string, folder, "", "ingest: every mesh file in this folder (id =
 ABSL_FLAG(std::string, out, "", "output folder");
 ABSL_FLAG(std::string, job, "", "status: a job id to follow until it ends");
 ABSL_FLAG(int, top_k, 10, "query: results to print");
+ABSL_FLAG(std::string, image, "",
+          "query: a picture (PNG or JPEG) of an object to query with instead of a MODEL; the "
+          "collection needs lfd (the default fusion has it)");
 ABSL_FLAG(int, candidates, 0,
           "query: 0 searches exactly; N re-ranks the N candidates an embedding proposes "
           "(faster on large collections, may miss a neighbour); on a fused collection each "
@@ -115,6 +118,7 @@ absl::StatusOr<CliFlags> ReadCliFlags(const flags::ParamFlags& params) {
   f.job = absl::GetFlag(FLAGS_job);
   f.top_k = absl::GetFlag(FLAGS_top_k);
   f.candidates = absl::GetFlag(FLAGS_candidates);
+  f.image = absl::GetFlag(FLAGS_image);
   f.port = absl::GetFlag(FLAGS_port);
   f.metrics_port = absl::GetFlag(FLAGS_metrics_port);
 

@@ -31,6 +31,7 @@ struct CliFlags {
   std::string job;         // --job (status)
   int top_k = 10;          // --top_k (query)
   int candidates = 0;      // --candidates (query)
+  std::string image;       // --image (query by picture)
   int port = -1;           // --port (serve, web); -1: the command's default
   int metrics_port = 0;    // --metrics_port (serve)
 

@@ -14,7 +14,9 @@
 #include "cli/coordinator_client.h"
 #include "cli/output_format.h"
 #include "common/base/status_macros.h"
+#include "common/base/file_io.h"
 #include "common/geometry/mesh_io.h"
+#include "common/global/picture_silhouette.h"
 #include "common/pipeline/retrieval_pipeline.h"
 #include "common/rpc/server.h"
 #include "common/wire/convert.h"
@@ -67,9 +69,28 @@ absl::Status RunBuild(const CliFlags& flags) {
   return client->Build(flags.collection);
 }
 
-absl::Status RunQuery(const CliFlags& flags, const std::string& model_path) {
-  if (flags.collection.empty()) return absl::InvalidArgumentError("query needs --collection NAME");
-  if (model_path.empty()) return absl::InvalidArgumentError("query needs a mesh file: meshseek query MODEL");
+namespace {
+
+// The query's answer from the coordinator: by mesh (QueryRequest) or by
+// picture (QueryByImageRequest, --image).
+absl::StatusOr<v1::QueryResponse> AskQuery(const CliFlags& flags, const std::string& model_path) {
+  if (model_path.empty() == flags.image.empty()) {
+    return absl::InvalidArgumentError(
+        "query needs a mesh file or a picture, one of them: meshseek query MODEL, or "
+        "meshseek query --image PICTURE");
+  }
+  v1::QueryResponse response;
+  if (!flags.image.empty()) {
+    v1::QueryByImageRequest request;
+    request.set_collection(flags.collection);
+    request.set_top_k(flags.top_k);
+    MESHSEEK_ASSIGN_OR_RETURN(*request.mutable_image(),
+                              ReadFileToString(flags.image, kMaxPictureFileBytes));
+    MESHSEEK_ASSIGN_OR_RETURN(auto client, CoordinatorClient::Open(flags.client));
+    MESHSEEK_RETURN_IF_ERROR(client->Call(&v1::Coordinator::Stub::QueryByImage, request,
+                                          &response, absl::Minutes(1)));
+    return response;
+  }
   MESHSEEK_ASSIGN_OR_RETURN(const TriangleMesh mesh,
                             ReadMesh(model_path, nullptr, flags.client.mesh_limits));
   MESHSEEK_ASSIGN_OR_RETURN(auto client, CoordinatorClient::Open(flags.client));
@@ -78,20 +99,37 @@ absl::Status RunQuery(const CliFlags& flags, const std::string& model_path) {
   request.set_top_k(flags.top_k);
   request.set_candidates(flags.candidates);
   wire::MeshToProto(mesh, request.mutable_mesh()->mutable_mesh());
-  v1::QueryResponse response;
   MESHSEEK_RETURN_IF_ERROR(
       client->Call(&v1::Coordinator::Stub::Query, request, &response, absl::Minutes(5)));
+  return response;
+}
+
+}  // namespace
+
+absl::Status RunQuery(const CliFlags& flags, const std::string& model_path) {
+  if (flags.collection.empty()) return absl::InvalidArgumentError("query needs --collection NAME");
+  MESHSEEK_ASSIGN_OR_RETURN(const v1::QueryResponse response, AskQuery(flags, model_path));
   if (flags.format == OutputFormat::kJson) {
     std::printf("%s\n", ProtoToJson(response).c_str());
     return absl::OkStatus();
   }
-  std::printf("%u features; nearest in '%s':\n", response.query_features(), flags.collection.c_str());
+  if (flags.image.empty()) {
+    std::printf("%u features; nearest in '%s':\n", response.query_features(),
+                flags.collection.c_str());
+  } else {
+    std::printf("nearest in '%s' to the picture:\n", flags.collection.c_str());
+  }
   std::printf("%4s  %-24s %-16s %s\n", "rank", "model", "label", "distance");
   int rank = 0;
   for (const v1::ScoredModel& r : response.results()) {
     std::printf("%4d  %-24s %-16s %.6g\n", ++rank, r.model_id().c_str(), r.label().c_str(), r.distance());
   }
   const v1::QueryTimings& t = response.timings();
+  if (!flags.image.empty()) {
+    std::printf("coordinator: picture %.0f ms, silhouette and view %.0f ms, search %.0f ms\n",
+                1e3 * t.mesh_seconds(), 1e3 * t.signatures_seconds(), 1e3 * t.search_seconds());
+    return absl::OkStatus();
+  }
   std::string methods;
   for (const v1::MethodTiming& m : t.methods()) {
     absl::StrAppendFormat(&methods, "%s%s %.0f + %.0f", methods.empty() ? "" : ", ", m.method(),

@@ -47,8 +47,10 @@ Commands:
            meshseek ingest --collection C --manifest FILE | --folder DIR
   build  Train the collection's codebook and index every model:
            meshseek build --collection C
-  query  Rank a collection's models by similarity to a mesh:
+  query  Rank a collection's models by similarity to a mesh, or to a picture
+         (PNG or JPEG: a photo, rendering or drawing of an object; needs lfd):
            meshseek query MODEL --collection C --top_k 10
+           meshseek query --image PICTURE --collection C
   status List the collections, show one, or follow a job:
            meshseek status [--collection C | --job ID]
   serve  Run the embedded stack until Ctrl-C: meshseek serve --port 50051

@@ -179,3 +179,15 @@ class Client:
         request = pb.QueryRequest(collection=collection, mesh=mesh_file(path),
                                   top_k=top_k, candidates=candidates)
         return self.stub.Query(request, timeout=timeout)
+
+    def query_by_image(self, collection, path, top_k=10, timeout=60.0):
+        """Ranks the models of `collection` by how much they look like the
+        picture in the PNG or JPEG file `path` (a photo, rendering or drawing
+        of one object; the collection needs lfd, as the default fusion has).
+
+        Returns the QueryResponse, as query does.
+        """
+        with open(path, "rb") as f:
+            image = f.read()
+        request = pb.QueryByImageRequest(collection=collection, image=image, top_k=top_k)
+        return self.stub.QueryByImage(request, timeout=timeout)

@@ -12,6 +12,7 @@ PACKAGES=(
   libopenmesh-dev                                    # mesh file readers
   libopencv-dev                                      # SIFT descriptor (features2d)
   libpng-dev                                         # PNG thumbnails and pictures (not OpenCV's imgcodecs: 65 ms a process start)
+  libjpeg-dev                                        # JPEG pictures to query with (libjpeg-turbo)
   libflann-dev liblz4-dev                            # k-nearest-neighbour graph (RLD-SIFT)
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # services
   libsqlite3-dev                                     # state of the stateful services

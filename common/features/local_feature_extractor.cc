@@ -121,7 +121,9 @@ const std::vector<FeatureMethodInfo>& FeatureMethods() {
        [](const ExtractorOptions& o) { return o.lfd.Validate(); },
        ExtractLightField,
        LightFieldDistance,
-       kLfdDescriptorBytes},
+       kLfdDescriptorBytes,
+       LfdViewDistance,
+       kLfdViewStride},
   };
   return *kMethods;
 }

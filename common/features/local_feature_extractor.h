@@ -73,6 +73,12 @@ struct FeatureMethodInfo {
   float (*distance)(const uint8_t* a, const uint8_t* b, std::size_t dimension) = nullptr;
   /// kGlobal: the descriptor's size in bytes (what `distance` reads).
   std::size_t descriptor_bytes = 0;
+  /// kGlobal methods whose descriptor is a model's views (LFD): the distance
+  /// of one view of `view_bytes` (a picture's, picture_silhouette.h) to a
+  /// model's descriptor, the model's nearest view deciding. nullptr and 0
+  /// for the others, which cannot be queried by a picture.
+  float (*view_distance)(const uint8_t* view, const uint8_t* descriptor) = nullptr;
+  std::size_t view_bytes = 0;
 };
 
 /// The distance of a global method between two models' features; InvalidArgument

@@ -147,6 +147,32 @@ bool UseAvx2(SimdLevel level) {
 #endif
 }
 
+// Writes the block of one silhouette (`centroid` its ComputeCentroid) with
+// the Zernike disc of `radius`; zeros when nothing is covered.
+absl::Status DescribeView(const BinaryImageView& image,
+                          const SilhouetteCentroid& centroid,
+                          double radius,
+                          const ContourFourierOptions& fourier_options,
+                          uint8_t* block) {
+  if (centroid.pixels == 0) return absl::OkStatus();  // sees nothing: zeros
+  // A silhouette of one pixel has radius 0 about its centroid: any positive
+  // radius then describes it (all its moments vanish but A_00).
+  if (!(radius > 0)) radius = 1;
+  absl::StatusOr<std::array<double, kZernikeCoefficients>> zernike =
+      ZernikeMagnitudes(image, centroid.x, centroid.y, radius);
+  if (!zernike.ok()) return zernike.status();
+  absl::StatusOr<std::array<double, kFourierCoefficients>> fourier =
+      CentroidDistanceFourier(OuterContour(image), {centroid.x, centroid.y}, fourier_options);
+  if (!fourier.ok()) return fourier.status();
+  for (int k = 0; k < kZernikeCoefficients; ++k) {
+    block[k] = QuantizeLfdCoefficient((*zernike)[k], kLfdZernikeScale);
+  }
+  for (int k = 0; k < kFourierCoefficients; ++k) {
+    block[kZernikeCoefficients + k] = QuantizeLfdCoefficient((*fourier)[k], kLfdFourierScale);
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::Status LfdOptions::Validate() const {
@@ -208,27 +234,46 @@ absl::StatusOr<std::vector<uint8_t>> ExtractLfd(const TriangleMesh& mesh,
     }
     for (int v = 0; v < kLfdViewsPerLightField; ++v) {
       uint8_t* block = out.data() + (l * kLfdViewsPerLightField + v) * kLfdViewStride;
-      if (centroids[v].pixels == 0) continue;  // sees nothing: zeros
-      const BinaryImageView image{masks[v].data(), n, n};
-      double radius = options.zernike_radius == LfdZernikeRadius::kPerView ? radii[v] : shared;
-      // A silhouette of one pixel has radius 0 about its centroid: any
-      // positive radius then describes it (all its moments vanish but A_00).
-      if (!(radius > 0)) radius = 1;
-      absl::StatusOr<std::array<double, kZernikeCoefficients>> zernike =
-          ZernikeMagnitudes(image, centroids[v].x, centroids[v].y, radius);
-      if (!zernike.ok()) return zernike.status();
-      absl::StatusOr<std::array<double, kFourierCoefficients>> fourier = CentroidDistanceFourier(
-          OuterContour(image), {centroids[v].x, centroids[v].y}, fourier_options);
-      if (!fourier.ok()) return fourier.status();
-      for (int k = 0; k < kZernikeCoefficients; ++k) {
-        block[k] = QuantizeLfdCoefficient((*zernike)[k], kLfdZernikeScale);
-      }
-      for (int k = 0; k < kFourierCoefficients; ++k) {
-        block[kZernikeCoefficients + k] = QuantizeLfdCoefficient((*fourier)[k], kLfdFourierScale);
+      const double radius =
+          options.zernike_radius == LfdZernikeRadius::kPerView ? radii[v] : shared;
+      if (absl::Status s = DescribeView({masks[v].data(), n, n}, centroids[v], radius,
+                                        fourier_options, block);
+          !s.ok()) {
+        return s;
       }
     }
   }
   return out;
+}
+
+absl::StatusOr<std::array<uint8_t, kLfdViewStride>> DescribeLfdSilhouette(
+    const BinaryImageView& silhouette, const LfdOptions& options) {
+  if (absl::Status s = options.Validate(); !s.ok()) return s;
+  if (silhouette.pixels == nullptr || silhouette.width <= 0 || silhouette.height <= 0) {
+    return absl::InvalidArgumentError("lfd: an empty image has no silhouette to describe");
+  }
+  ContourFourierOptions fourier_options;
+  fourier_options.samples = options.contour_samples;
+  const SilhouetteCentroid centroid = ComputeCentroid(silhouette);
+  std::array<uint8_t, kLfdViewStride> block{};
+  if (absl::Status s =
+          DescribeView(silhouette, centroid, LargestRadius(silhouette, centroid.x, centroid.y),
+                       fourier_options, block.data());
+      !s.ok()) {
+    return s;
+  }
+  return block;
+}
+
+float LfdViewDistance(const uint8_t* view, const uint8_t* descriptor) {
+  int best = std::numeric_limits<int>::max();
+  for (int v = 0; v < kLfdViews; ++v) {
+    const uint8_t* other = descriptor + v * kLfdViewStride;
+    int sum = 0;
+    for (int k = 0; k < kLfdCoefficientsPerView; ++k) sum += std::abs(view[k] - other[k]);
+    best = std::min(best, sum);
+  }
+  return static_cast<float>(best);
 }
 
 absl::Status ValidateLfdDescriptor(const std::vector<uint8_t>& descriptor) {

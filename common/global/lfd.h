@@ -43,6 +43,7 @@
 #ifndef MESHSEEK_COMMON_GLOBAL_LFD_H_
 #define MESHSEEK_COMMON_GLOBAL_LFD_H_
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -107,6 +108,27 @@ uint8_t QuantizeLfdCoefficient(double value, double scale);
 /// Deterministic; single-threaded (parallelise across models).
 absl::StatusOr<std::vector<uint8_t>> ExtractLfd(const TriangleMesh& mesh,
                                                 const LfdOptions& options);
+
+/// One view's block of kLfdViewStride bytes for any silhouette (1 where
+/// covered), described as ExtractLfd describes each rendered view: what a
+/// picture queries with (picture_silhouette.h). The Zernike disc is the
+/// silhouette's own, whatever options.zernike_radius says (a picture has no
+/// light field to share one with); the silhouette's position and size do not
+/// matter (both descriptors are centred on its centroid and scaled by it).
+/// An empty silhouette gives zeros. InvalidArgument for bad options or an
+/// empty image.
+absl::StatusOr<std::array<uint8_t, kLfdViewStride>> DescribeLfdSilhouette(
+    const BinaryImageView& silhouette, const LfdOptions& options);
+
+/// The distance of one view's block (DescribeLfdSilhouette) to a model's
+/// descriptor (kLfdDescriptorBytes, not checked): the smallest L1 distance
+/// of its 45 coefficients to any of the model's 100 views, so the view that
+/// looks most like the picture decides (Chen et al.'s query by one image).
+/// The mirror image needs no second search: reflecting a silhouette
+/// conjugates its Zernike moments and reverses its contour, neither of which
+/// changes a magnitude, so it has the same block. Exact (an integer);
+/// thread-safe.
+float LfdViewDistance(const uint8_t* view, const uint8_t* descriptor);
 
 /// InvalidArgument unless `descriptor` has kLfdDescriptorBytes bytes with
 /// zero padding (a descriptor ExtractLfd wrote). For data read from outside.

@@ -6,9 +6,11 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/geometry/test_meshes.h"
+#include "common/render/view_renderer.h"
 
 namespace meshseek {
 namespace {
@@ -257,6 +259,66 @@ TEST(LfdDistanceMatrixTest, MatchesPairwiseDistancesOnAnyThreadCount) {
   auto bad = LfdDistanceMatrix(d, 1);
   EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_NE(std::string(bad.status().message()).find("model 2"), std::string::npos);
+}
+
+
+// A rendered view described alone is the block ExtractLfd wrote for it: one
+// way to describe a silhouette, for models and pictures alike.
+TEST(DescribeLfdSilhouetteTest, ARenderedViewGivesExtractLfdsBlockAndDistanceZero) {
+  const LfdOptions options;
+  const TriangleMesh mesh = Shapes()[4].mesh;  // the L
+  const absl::StatusOr<std::vector<uint8_t>> descriptor = ExtractLfd(mesh, options);
+  ASSERT_TRUE(descriptor.ok()) << descriptor.status();
+  ViewRenderOptions render_options;
+  render_options.image_size = options.image_size;
+  absl::StatusOr<ViewRenderer> renderer = ViewRenderer::Create(mesh, render_options);
+  ASSERT_TRUE(renderer.ok()) << renderer.status();
+  for (const auto& [l, v] : {std::pair{0, 0}, std::pair{3, 7}, std::pair{9, 9}}) {
+    const std::vector<uint8_t> mask =
+        renderer->Render(Rotate(LightFieldRotations()[l], LightFieldViewDirections()[v])).mask;
+    const auto block = DescribeLfdSilhouette({mask.data(), options.image_size, options.image_size},
+                                             options);
+    ASSERT_TRUE(block.ok()) << block.status();
+    const uint8_t* written = descriptor->data() + (l * kLfdViewsPerLightField + v) * kLfdViewStride;
+    EXPECT_TRUE(std::equal(block->begin(), block->end(), written)) << "view " << l << "," << v;
+    EXPECT_EQ(LfdViewDistance(block->data(), descriptor->data()), 0);
+  }
+}
+
+TEST(DescribeLfdSilhouetteTest, ViewDistanceIsTheNearestViewsL1AndMirrorsMatch) {
+  const LfdOptions options;
+  const std::vector<NamedShape> shapes = Shapes();
+  const std::vector<uint8_t> plank = *ExtractLfd(shapes[1].mesh, options);
+  // An asymmetric silhouette (an L of pixels) and its mirror image.
+  const int n = options.image_size;
+  std::vector<uint8_t> ell(static_cast<std::size_t>(n) * n, 0), mirror = ell;
+  for (int y = 20; y < 100; ++y) {
+    for (int x = 30; x < 90; ++x) {
+      if (x < 50 || y > 80) ell[y * n + x] = mirror[y * n + (n - 1 - x)] = 1;
+    }
+  }
+  const auto a = DescribeLfdSilhouette({ell.data(), n, n}, options);
+  const auto b = DescribeLfdSilhouette({mirror.data(), n, n}, options);
+  ASSERT_TRUE(a.ok() && b.ok());
+  int mirror_l1 = 0;
+  for (int k = 0; k < kLfdCoefficientsPerView; ++k) mirror_l1 += std::abs((*a)[k] - (*b)[k]);
+  EXPECT_LE(mirror_l1, 2);  // the same up to rounding at a quantisation step
+  float best = 1e9f;
+  for (int v = 0; v < kLfdViews; ++v) {
+    float sum = 0;
+    for (int k = 0; k < kLfdCoefficientsPerView; ++k) {
+      sum += std::abs((*a)[k] - plank[v * kLfdViewStride + k]);
+    }
+    best = std::min(best, sum);
+  }
+  EXPECT_EQ(LfdViewDistance(a->data(), plank.data()), best);
+  EXPECT_GT(best, 0);
+  // Empty images are refused; an empty silhouette describes as zeros.
+  EXPECT_FALSE(DescribeLfdSilhouette({nullptr, 0, 0}, options).ok());
+  const std::vector<uint8_t> blank(static_cast<std::size_t>(n) * n, 0);
+  const auto zeros = DescribeLfdSilhouette({blank.data(), n, n}, options);
+  ASSERT_TRUE(zeros.ok());
+  EXPECT_TRUE(std::all_of(zeros->begin(), zeros->end(), [](uint8_t b) { return b == 0; }));
 }
 
 }  // namespace

@@ -65,9 +65,9 @@ bool GlobalDescriptorIndex::Remove(uint32_t doc) {
   return true;
 }
 
-absl::StatusOr<std::vector<KlNeighbor>> GlobalDescriptorIndex::Distances(
-    absl::Span<const uint8_t> query, int num_threads) const {
-  if (absl::Status s = CheckSize(query.size()); !s.ok()) return s;
+template <typename Distance>
+std::vector<KlNeighbor> GlobalDescriptorIndex::Scan(const Distance& distance,
+                                                    int num_threads) const {
   std::vector<KlNeighbor> out(docs_.size());
   // Blocks of docs per task: one distance is microseconds.
   constexpr std::size_t kBlock = 64;
@@ -75,10 +75,18 @@ absl::StatusOr<std::vector<KlNeighbor>> GlobalDescriptorIndex::Distances(
   ParallelFor(blocks, num_threads, [&](std::size_t b) {
     const std::size_t end = std::min(docs_.size(), (b + 1) * kBlock);
     for (std::size_t i = b * kBlock; i < end; ++i) {
-      out[i] = {docs_[i], distance_(query.data(), data_.data() + i * dimension_, dimension_)};
+      out[i] = {docs_[i], distance(data_.data() + i * dimension_)};
     }
   });
   return out;
+}
+
+absl::StatusOr<std::vector<KlNeighbor>> GlobalDescriptorIndex::Distances(
+    absl::Span<const uint8_t> query, int num_threads) const {
+  if (absl::Status s = CheckSize(query.size()); !s.ok()) return s;
+  return Scan(
+      [&](const uint8_t* stored) { return distance_(query.data(), stored, dimension_); },
+      num_threads);
 }
 
 absl::StatusOr<std::vector<KlNeighbor>> GlobalDescriptorIndex::DistancesTo(
@@ -101,20 +109,43 @@ absl::StatusOr<absl::Span<const uint8_t>> GlobalDescriptorIndex::Descriptor(uint
   return absl::MakeConstSpan(data_.data() + it->second * dimension_, dimension_);
 }
 
+namespace {
+
+// The k nearest of `all` (ties by doc) and every one tied with the k-th.
+std::vector<KlNeighbor> Nearest(std::vector<KlNeighbor> all, std::size_t k) {
+  auto less = [](const KlNeighbor& a, const KlNeighbor& b) {
+    return std::tie(a.distance, a.doc) < std::tie(b.distance, b.doc);
+  };
+  std::sort(all.begin(), all.end(), less);
+  std::size_t keep = std::min(k, all.size());
+  while (keep > 0 && keep < all.size() && all[keep].distance == all[keep - 1].distance) ++keep;
+  all.resize(keep);
+  return all;
+}
+
+}  // namespace
+
 absl::StatusOr<std::vector<KlNeighbor>> GlobalDescriptorIndex::Search(
     absl::Span<const uint8_t> query, std::size_t k, int num_threads) const {
   absl::StatusOr<std::vector<KlNeighbor>> all = Distances(query, num_threads);
   if (!all.ok()) return all.status();
-  auto less = [](const KlNeighbor& a, const KlNeighbor& b) {
-    return std::tie(a.distance, a.doc) < std::tie(b.distance, b.doc);
-  };
-  std::sort(all->begin(), all->end(), less);
-  std::size_t keep = std::min(k, all->size());
-  while (keep > 0 && keep < all->size() && (*all)[keep].distance == (*all)[keep - 1].distance) {
-    ++keep;
+  return Nearest(*std::move(all), k);
+}
+
+absl::StatusOr<std::vector<KlNeighbor>> GlobalDescriptorIndex::SearchView(
+    absl::Span<const uint8_t> view, std::size_t k, int num_threads) const {
+  const FeatureMethodInfo& info = FeatureMethodInfoOf(method_);
+  if (info.view_distance == nullptr) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "a ", info.name, " collection cannot be searched by a picture: its descriptors are not views"));
   }
-  all->resize(keep);
-  return all;
+  if (view.size() != info.view_bytes) {
+    return absl::InvalidArgumentError(absl::StrCat("a view of ", view.size(), " bytes but ",
+                                                   info.name, " views have ", info.view_bytes));
+  }
+  return Nearest(Scan([&](const uint8_t* stored) { return info.view_distance(view.data(), stored); },
+                      num_threads),
+                 k);
 }
 
 void GlobalDescriptorIndex::ForEach(

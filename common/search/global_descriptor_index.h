@@ -49,6 +49,12 @@ class GlobalDescriptorIndex {
   absl::StatusOr<std::vector<KlNeighbor>> Search(absl::Span<const uint8_t> query,
                                                  std::size_t k,
                                                  int num_threads) const;
+  /// Search by one view (a picture's) with the method's view_distance, for
+  /// a method whose descriptors are views (LFD). InvalidArgument for another
+  /// method or a view of another size.
+  absl::StatusOr<std::vector<KlNeighbor>> SearchView(absl::Span<const uint8_t> view,
+                                                     std::size_t k,
+                                                     int num_threads) const;
 
   /// The descriptor stored for `doc` (valid until the next write), or NotFound.
   absl::StatusOr<absl::Span<const uint8_t>> Descriptor(uint32_t doc) const;
@@ -59,6 +65,9 @@ class GlobalDescriptorIndex {
   GlobalDescriptorIndex(FeatureMethod method, std::size_t dimension)
       : method_(method), dimension_(dimension) {}
   absl::Status CheckSize(std::size_t bytes) const;
+  // `distance(slot)` of every doc, in slot order.
+  template <typename Distance>
+  std::vector<KlNeighbor> Scan(const Distance& distance, int num_threads) const;
 
   FeatureMethod method_;
   std::size_t dimension_;

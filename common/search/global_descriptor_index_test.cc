@@ -73,5 +73,29 @@ TEST(GlobalDescriptorIndexTest, SearchIsTheExhaustiveRankingAndSurvivesRemovals)
   EXPECT_EQ(visited, 39u);
 }
 
+TEST(GlobalDescriptorIndexTest, SearchByViewRanksByEachModelsNearestView) {
+  auto index = GlobalDescriptorIndex::Create(FeatureMethod::kLfd, kLfdDescriptorBytes);
+  ASSERT_TRUE(index.ok());
+  std::vector<std::vector<uint8_t>> data;
+  for (uint32_t i = 0; i < 50; ++i) {
+    data.push_back(RandomLfd(100 + i));
+    ASSERT_TRUE(index->Upsert(i, data.back()).ok());
+  }
+  // Model 23's view 61 as the picture: model 23 first, at distance 0.
+  const absl::Span<const uint8_t> view(data[23].data() + 61 * kLfdViewStride, kLfdViewStride);
+  const auto found = index->SearchView(view, 5, 2);
+  ASSERT_TRUE(found.ok()) << found.status();
+  ASSERT_GE(found->size(), 5u);
+  EXPECT_EQ((*found)[0].doc, 23u);
+  EXPECT_EQ((*found)[0].distance, 0);
+  // Every distance is LfdViewDistance, in ascending order.
+  for (std::size_t r = 0; r < found->size(); ++r) {
+    EXPECT_EQ((*found)[r].distance, LfdViewDistance(view.data(), data[(*found)[r].doc].data()));
+    if (r > 0) EXPECT_LE((*found)[r - 1].distance, (*found)[r].distance);
+  }
+  EXPECT_EQ(index->SearchView(absl::MakeConstSpan(data[0].data(), 10), 5, 1).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace meshseek

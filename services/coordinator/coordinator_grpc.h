@@ -50,6 +50,11 @@ class CoordinatorGrpc final : public v1::Coordinator::Service {
                      v1::QueryResponse* response) override {
     return rpc::Serve(context, request, response, service_, &CoordinatorService::Query);
   }
+  grpc::Status QueryByImage(grpc::ServerContext* context,
+                            const v1::QueryByImageRequest* request,
+                            v1::QueryResponse* response) override {
+    return rpc::Serve(context, request, response, service_, &CoordinatorService::QueryByImage);
+  }
   grpc::Status RemoveModel(grpc::ServerContext* context,
                            const v1::RemoveModelFromCollectionRequest* request,
                            v1::RemoveModelFromCollectionResponse* response) override {

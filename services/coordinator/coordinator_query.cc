@@ -1,4 +1,4 @@
-// CoordinatorService: Query and Evaluate (coordinator_service.h). A
+// CoordinatorService: Query, QueryByImage and Evaluate (coordinator_service.h). A
 // collection of one method without re-ranking is ranked by the index alone
 // (top-k merged over the shards, its own distances); a fused or re-ranked one
 // by its build's Ranking (ranking.h), with the models that joined it live
@@ -9,9 +9,11 @@
 #include <optional>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "absl/time/clock.h"
 #include "common/base/parallel.h"
 #include "common/base/status_macros.h"
+#include "common/global/picture_silhouette.h"
 #include "common/wire/convert.h"
 #include "services/coordinator/coordinator_service.h"
 #include "services/coordinator/fused_candidates.h"
@@ -190,6 +192,61 @@ absl::StatusOr<v1::QueryResponse> CoordinatorService::Query(const v1::QueryReque
   }
   for (v1::ScoredModel& m : found) *response.add_results() = std::move(m);
   timings.set_search_seconds(absl::ToDoubleSeconds(absl::Now() - search_start));
+  return response;
+}
+
+absl::StatusOr<v1::QueryResponse> CoordinatorService::QueryByImage(
+    const v1::QueryByImageRequest& request, const rpc::CallContext&) {
+  if (request.top_k() == 0) return absl::InvalidArgumentError("query: top_k must be at least 1");
+  if (request.image().size() > kMaxPictureFileBytes) {
+    return absl::InvalidArgumentError(absl::StrCat("query by picture: a file of ",
+                                                   request.image().size(), " bytes; at most ",
+                                                   kMaxPictureFileBytes));
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(const CollectionPlan plan, PublicPlan(request.collection()));
+  // The member whose descriptors are views (docs/design.md 2.7d).
+  const CollectionInfo* views = nullptr;
+  for (const CollectionInfo& part : plan.parts) {
+    if (FeatureMethodInfoOf(part.options.extractor.method).view_distance != nullptr) views = &part;
+  }
+  if (views == nullptr) {
+    std::vector<std::string> methods;
+    for (const CollectionInfo& part : plan.parts) {
+      methods.push_back(FeatureMethodName(part.options.extractor.method));
+    }
+    return absl::FailedPreconditionError(absl::StrCat(
+        "query by picture: collection '", request.collection(), "' (", absl::StrJoin(methods, "+"),
+        ") holds no views of its models to match a picture against; it needs lfd "
+        "(--method lfd, or a fusion with lfd such as the default bfdsift+rld+lsf+lfd)"));
+  }
+  if (plan.codebook_id.empty()) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("collection '", request.collection(), "' is not built yet"));
+  }
+  v1::QueryResponse response;
+  v1::QueryTimings& timings = *response.mutable_timings();
+  absl::Time start = absl::Now();
+  absl::StatusOr<cv::Mat> picture = DecodePicture(request.image());
+  if (!picture.ok()) return Prefixed(picture.status(), "query by picture: ");
+  timings.set_mesh_seconds(absl::ToDoubleSeconds(absl::Now() - start));
+  start = absl::Now();
+  const LfdOptions& lfd = views->options.extractor.lfd;
+  PictureSilhouetteOptions silhouette_options;
+  silhouette_options.image_size = lfd.image_size;
+  absl::StatusOr<std::vector<uint8_t>> silhouette = PictureSilhouette(*picture, silhouette_options);
+  if (!silhouette.ok()) return Prefixed(silhouette.status(), "query by picture: ");
+  MESHSEEK_ASSIGN_OR_RETURN(
+      const auto view,
+      DescribeLfdSilhouette({silhouette->data(), lfd.image_size, lfd.image_size}, lfd));
+  timings.set_signatures_seconds(absl::ToDoubleSeconds(absl::Now() - start));
+  start = absl::Now();
+  v1::SearchRequest search;
+  search.set_collection(views->name);
+  search.set_picture_view(view.data(), view.size());
+  search.set_top_k(request.top_k());
+  MESHSEEK_ASSIGN_OR_RETURN(std::vector<v1::ScoredModel> found, workers_.index()->Search(search));
+  for (v1::ScoredModel& m : found) *response.add_results() = std::move(m);
+  timings.set_search_seconds(absl::ToDoubleSeconds(absl::Now() - start));
   return response;
 }
 

@@ -75,6 +75,7 @@ class CoordinatorService final {
   absl::StatusOr<v1::JobStatus> GetJob(const v1::JobRequest& request, const rpc::CallContext& call);
   absl::Status WatchJob(const v1::JobRequest& request, rpc::Writer<v1::JobStatus> write, const rpc::CallContext& call);
   absl::StatusOr<v1::QueryResponse> Query(const v1::QueryRequest& request, const rpc::CallContext& call);
+  absl::StatusOr<v1::QueryResponse> QueryByImage(const v1::QueryByImageRequest& request, const rpc::CallContext& call);
   absl::StatusOr<v1::RemoveModelFromCollectionResponse> RemoveModel(const v1::RemoveModelFromCollectionRequest& request, const rpc::CallContext& call);
   absl::StatusOr<v1::ListCollectionModelsResponse> ListModels(const v1::ListCollectionModelsRequest& request, const rpc::CallContext& call);
   absl::StatusOr<v1::ListCollectionsResponse> ListCollections(const v1::ListCollectionsRequest& request, const rpc::CallContext& call);

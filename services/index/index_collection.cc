@@ -245,6 +245,22 @@ absl::StatusOr<std::vector<IndexCollection::Hit>> IndexCollection::Search(
   return Ranked(found, top_k);
 }
 
+absl::StatusOr<std::vector<IndexCollection::Hit>> IndexCollection::SearchView(
+    absl::string_view view, std::size_t top_k, int num_threads) const {
+  if (empty()) return std::vector<Hit>();
+  const auto* global = std::get_if<GlobalDescriptorIndex>(&*engine_);
+  if (global == nullptr) {
+    return absl::InvalidArgumentError(
+        "a collection of histograms cannot be searched by a picture (it needs lfd's views)");
+  }
+  MESHSEEK_ASSIGN_OR_RETURN(
+      const std::vector<KlNeighbor> found,
+      global->SearchView(
+          absl::MakeConstSpan(reinterpret_cast<const uint8_t*>(view.data()), view.size()), top_k,
+          num_threads));
+  return Ranked(found, top_k);
+}
+
 std::vector<IndexCollection::Hit> IndexCollection::Ranked(const std::vector<KlNeighbor>& found,
                                                           std::size_t top_k) const {
   // The engine breaks ties by doc and returns every model tied with the k-th:

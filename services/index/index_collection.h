@@ -26,6 +26,7 @@
 
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "common/search/global_descriptor_index.h"
 #include "common/search/kl_inverted_index.h"
 #include "meshseek/v1/index.pb.h"
@@ -91,6 +92,14 @@ class IndexCollection {
                                           std::size_t top_k,
                                           std::size_t candidates,
                                           int num_threads) const;
+  /// The `top_k` nearest models to one view of a picture (`view`, the
+  /// method's view_bytes: lfd.h DescribeLfdSilhouette) in a collection of
+  /// views (LFD), each model at its nearest view, in (distance, ordinal,
+  /// model id) order. InvalidArgument for a collection of another kind or a
+  /// view of another size.
+  absl::StatusOr<std::vector<Hit>> SearchView(absl::string_view view,
+                                              std::size_t top_k,
+                                              int num_threads) const;
   /// Each query's distance to every model, or to those of `model_ids` held
   /// (each once) when it is not empty, as the Distances RPC answers: the
   /// models in order, then the row-major matrix. An empty histogram query

@@ -192,5 +192,27 @@ TEST(IndexCollectionTest, ExportsASubsetWithOrWithoutSignatures) {
   EXPECT_THAT(full[1].histogram().bins(), ElementsAre(1, 3));
 }
 
+TEST(IndexCollectionTest, APicturesViewSearchesViewsOnly) {
+  IndexCollection views;
+  ASSERT_TRUE(views.Place("c", 2, "y", Descriptor(9)).ok());
+  ASSERT_TRUE(views.Place("a", 0, "x", Descriptor(1)).ok());
+  ASSERT_TRUE(views.Place("b", 1, "x", Descriptor(5)).ok());
+  const std::string view(FeatureMethodInfoOf(FeatureMethod::kLfd).view_bytes, 5);
+  absl::StatusOr<std::vector<IndexCollection::Hit>> hits = views.SearchView(view, 3, 1);
+  ASSERT_TRUE(hits.ok()) << hits.status();
+  ASSERT_EQ(hits->size(), 3u);
+  // b's views are the picture's; a and c differ by 4 in each of 45 bytes.
+  EXPECT_EQ((*hits)[0].model->model_id, "b");
+  EXPECT_EQ((*hits)[0].distance, 0);
+  EXPECT_EQ((*hits)[1].model->model_id, "a");
+  EXPECT_EQ((*hits)[1].distance, 180);
+  EXPECT_EQ((*hits)[2].model->model_id, "c");
+  EXPECT_THAT(views.SearchView("short", 3, 1).status().message(), HasSubstr("5 bytes"));
+  IndexCollection histograms;
+  ASSERT_TRUE(histograms.Place("a", 0, "x", Histogram(8, {1, 2})).ok());
+  EXPECT_THAT(histograms.SearchView(view, 3, 1).status().message(),
+              HasSubstr("cannot be searched by a picture"));
+}
+
 }  // namespace
 }  // namespace meshseek

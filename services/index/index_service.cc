@@ -142,23 +142,57 @@ absl::Status IndexService::UseEpsilon(const std::string& name, double epsilon) {
   return it->second.SetEpsilon(epsilon);
 }
 
-absl::StatusOr<const IndexCollection*> IndexService::FindCollection(const std::string& name,
-                                                                    double epsilon) {
+absl::StatusOr<const IndexCollection*> IndexService::FindCollection(const std::string& name) {
   auto it = collections_.find(name);
   if (it == collections_.end() || it->second.empty()) {
     return absl::NotFoundError(absl::StrCat("index has no models in collection '", name, "'"));
   }
-  const std::optional<double> ranked_with = it->second.epsilon();  // none for descriptors
+  return &it->second;
+}
+
+absl::StatusOr<const IndexCollection*> IndexService::FindCollection(const std::string& name,
+                                                                    double epsilon) {
+  MESHSEEK_ASSIGN_OR_RETURN(const IndexCollection* collection, FindCollection(name));
+  const std::optional<double> ranked_with = collection->epsilon();  // none for descriptors
   if (ranked_with.has_value() && *ranked_with != EpsilonOrDefault(epsilon)) {
     return absl::AbortedError(absl::StrCat("collection '", name, "' is ranked with KL epsilon ",
                                            *ranked_with, " (changed meanwhile); retry"));
   }
-  return &it->second;
+  return collection;
 }
+
+namespace {
+
+v1::SearchResponse SearchResponseOf(const std::vector<IndexCollection::Hit>& hits) {
+  v1::SearchResponse response;
+  for (const IndexCollection::Hit& hit : hits) {
+    v1::ScoredModel* result = response.add_results();
+    result->set_model_id(hit.model->model_id);
+    result->set_label(hit.model->label);
+    result->set_distance(hit.distance);
+    result->set_ordinal(hit.model->ordinal);
+  }
+  return response;
+}
+
+}  // namespace
 
 absl::StatusOr<v1::SearchResponse> IndexService::Search(const v1::SearchRequest& request,
                                                         const rpc::CallContext&) {
   if (request.top_k() == 0) return absl::InvalidArgumentError("search: top_k must be at least 1");
+  if (!request.picture_view().empty()) {
+    if (request.has_histogram() || request.has_global_descriptor()) {
+      return absl::InvalidArgumentError(
+          "search: a picture's view and a histogram or descriptor: one query at a time");
+    }
+    absl::ReaderMutexLock lock(&mutex_);
+    MESHSEEK_ASSIGN_OR_RETURN(const IndexCollection* collection,
+                              FindCollection(request.collection()));
+    absl::StatusOr<std::vector<IndexCollection::Hit>> hits =
+        collection->SearchView(request.picture_view(), request.top_k(), options_.num_threads);
+    if (!hits.ok()) return Prefixed(hits.status(), absl::StrCat("search '", request.collection(), "': "));
+    return SearchResponseOf(*hits);
+  }
   MESHSEEK_ASSIGN_OR_RETURN(
       const ModelSignature query,
       SignatureOf(request.histogram(), request.has_global_descriptor(), request.global_descriptor(),
@@ -174,15 +208,7 @@ absl::StatusOr<v1::SearchResponse> IndexService::Search(const v1::SearchRequest&
   absl::StatusOr<std::vector<IndexCollection::Hit>> hits =
       collection->Search(query, request.top_k(), candidates, options_.num_threads);
   if (!hits.ok()) return Prefixed(hits.status(), absl::StrCat("search '", request.collection(), "': "));
-  v1::SearchResponse response;
-  for (const IndexCollection::Hit& hit : *hits) {
-    v1::ScoredModel* result = response.add_results();
-    result->set_model_id(hit.model->model_id);
-    result->set_label(hit.model->label);
-    result->set_distance(hit.distance);
-    result->set_ordinal(hit.model->ordinal);
-  }
-  return response;
+  return SearchResponseOf(*hits);
 }
 
 absl::Status IndexService::ExportModels(const v1::ExportModelsRequest& request,

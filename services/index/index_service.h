@@ -107,6 +107,10 @@ class IndexService final {
   // unknown or empty one, Aborted if another epsilon was asked for meanwhile.
   absl::StatusOr<const IndexCollection*> FindCollection(const std::string& name, double epsilon)
       ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  // The collection whatever it is ranked with (a search by picture, which
+  // has no epsilon); NotFound as above.
+  absl::StatusOr<const IndexCollection*> FindCollection(const std::string& name)
+      ABSL_SHARED_LOCKS_REQUIRED(mutex_);
 
   const IndexServiceOptions options_;
   KlIndexStorage storage_;

@@ -12,6 +12,7 @@ these folders.
 import os
 import struct
 import sys
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -170,6 +171,67 @@ def packed_varints(num, ns):
 def mesh_arrays(vertices, triangles):
     return packed_floats(1, [c for v in vertices for c in v]) + packed_varints(2, triangles)
 
+# Two small JPEG files our EncodeJpeg wrote (common/render/jpeg.h, quality 75):
+# a dark disc on white (24 x 24 grey) and a coloured box on white (20 x 16).
+JPEG_GREY = bytes.fromhex(
+    "ffd8ffe000104a46494600010100000100010000ffdb004300080606070605080707070909080a0c140d0c0b0b0c1912"
+    "130f141d1a1f1e1d1a1c1c20242e2720222c231c1c2837292c30313434341f27393d38323c2e333432ffc0000b080018"
+    "001801011100ffc4001f0000010501010101010100000000000000000102030405060708090a0bffc400b51000020103"
+    "03020403050504040000017d01020300041105122131410613516107227114328191a1082342b1c11552d1f024336272"
+    "82090a161718191a25262728292a3435363738393a434445464748494a535455565758595a636465666768696a737475"
+    "767778797a838485868788898a92939495969798999aa2a3a4a5a6a7a8a9aab2b3b4b5b6b7b8b9bac2c3c4c5c6c7c8c9"
+    "cad2d3d4d5d6d7d8d9dae1e2e3e4e5e6e7e8e9eaf1f2f3f4f5f6f7f8f9faffda0008010100003f00f7fae1ee3e2f7822"
+    "dafcdab6b1bb6ef0d347048f18652063217e6ce49057230a79e99ed209e2b98239e0952586550f1c91b0657523208238"
+    "208ef5c5fc5eb8bbb6f865aab5ab6ddde5c72b894a308da4507181f3672148240c31e7b1f95abe8df80971772f822f23"
+    "99b75bc37ccb01329257288cca148c2ae4e783c966e0753ea13c115cc12413c492c32a9492391432ba9182083c10476a"
+    "f2fb8f809e1896fccd1deea705bb6f2604910ed2482a158a92140dc30724e473c1cfa4e99a65968fa6c1a7e9f6e96f69"
+    "02ec8e24e807f3249c924f24924f35ffd9")
+JPEG_COLOUR = bytes.fromhex(
+    "ffd8ffe000104a46494600010100000100010000ffdb004300080606070605080707070909080a0c140d0c0b0b0c1912"
+    "130f141d1a1f1e1d1a1c1c20242e2720222c231c1c2837292c30313434341f27393d38323c2e333432ffdb0043010909"
+    "090c0b0c180d0d1832211c21323232323232323232323232323232323232323232323232323232323232323232323232"
+    "3232323232323232323232323232ffc00011080010001403012200021101031101ffc4001f0000010501010101010100"
+    "000000000000000102030405060708090a0bffc400b5100002010303020403050504040000017d010203000411051221"
+    "31410613516107227114328191a1082342b1c11552d1f02433627282090a161718191a25262728292a3435363738393a"
+    "434445464748494a535455565758595a636465666768696a737475767778797a838485868788898a9293949596979899"
+    "9aa2a3a4a5a6a7a8a9aab2b3b4b5b6b7b8b9bac2c3c4c5c6c7c8c9cad2d3d4d5d6d7d8d9dae1e2e3e4e5e6e7e8e9eaf1"
+    "f2f3f4f5f6f7f8f9faffc4001f0100030101010101010101010000000000000102030405060708090a0bffc400b51100"
+    "020102040403040705040400010277000102031104052131061241510761711322328108144291a1b1c109233352f015"
+    "6272d10a162434e125f11718191a262728292a35363738393a434445464748494a535455565758595a63646566676869"
+    "6a737475767778797a82838485868788898a92939495969798999aa2a3a4a5a6a7a8a9aab2b3b4b5b6b7b8b9bac2c3c4"
+    "c5c6c7c8c9cad2d3d4d5d6d7d8d9dae2e3e4e5e6e7e8e9eaf2f3f4f5f6f7f8f9faffda000c03010002110311003f00f5"
+    "0f19f89af7c3bf62fb2456efe7f99bbce5271b76e31823d4d72bff000b2f59ff009f6b0ffbf6ff00fc55755e33f0cdef"
+    "88bec5f6496dd3c8f33779cc46776dc6300fa1ae57fe15a6b3ff003f361ff7f1ff00f89af2315f5bf6afd9dedff00f67"
+    "09f53f62bdadb9bfe09ea9451457ae78c7ffd9")
+
+
+def png(width, height, colour_type, rows):
+    """A PNG file of 8-bit `rows` (bytes each, filter byte included)."""
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+    header = struct.pack(">IIBBBBB", width, height, 8, colour_type, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header)
+            + chunk(b"IDAT", zlib.compress(b"".join(rows))) + chunk(b"IEND", b""))
+
+
+def pictures():
+    """Seeds of the picture harness: each kind the decoders read, and the
+    hostile ones (truncated, 1 x 1, a header declaring 100,000 x 100,000)."""
+    disc = [b"\0" + bytes(40 if (x - 8) ** 2 + (y - 8) ** 2 < 30 else 250 for x in range(16))
+            for y in range(16)]
+    alpha = [b"\0" + b"".join(bytes((200, 200, 200, 255 if 4 <= x < 12 and 2 <= y < 14 else 0))
+                               for x in range(16)) for y in range(16)]
+    write("picture", "grey.png", png(16, 16, 0, disc))
+    write("picture", "alpha.png", png(16, 16, 6, alpha))
+    write("picture", "one_pixel.png", png(1, 1, 2, [b"\0\x10\x20\x30"]))
+    write("picture", "huge.png", png(100000, 100000, 0, [b"\0\0"]))
+    write("picture", "truncated.png", png(16, 16, 0, disc)[:60])
+    write("picture", "grey.jpg", JPEG_GREY)
+    write("picture", "colour.jpg", JPEG_COLOUR)
+    write("picture", "truncated.jpg", JPEG_COLOUR[:len(JPEG_COLOUR) * 2 // 3])
+    write("picture", "not_a_picture.txt", b"GIF89a is not read")
+
 
 def main():
     for fmt, seeds in MESH_SEEDS.items():
@@ -268,6 +330,7 @@ def main():
           + field_varint(17, 2**31 - 1))
     write("convert_params", "bad_strings.pb", field_bytes(13, b"sideways")
           + field_bytes(22, b"magic"))
+    pictures()
     return 0
 
 

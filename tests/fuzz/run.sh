@@ -19,7 +19,7 @@ cd "$(dirname "$0")/../.."
 BUILD_DIR=${1:?usage: tests/fuzz/run.sh BUILD_DIR [libFuzzer flags...]}
 shift
 ALL="mesh_off mesh_obj mesh_ply mesh_stl mesh_detect manifest class_file
-     convert_mesh convert_features convert_graph convert_histogram convert_params"
+     convert_mesh convert_features convert_graph convert_histogram convert_params picture"
 FUZZERS=${FUZZERS:-$ALL}
 JOBS=${JOBS:-$(nproc)}
 mkdir -p "$BUILD_DIR/fuzz-logs" "$BUILD_DIR/fuzz-artifacts"
