@@ -43,13 +43,16 @@ class PictureQueryTest : public ::testing::Test {
     auto models = MakeSyntheticModels(synth);
     ASSERT_TRUE(models.ok()) << models.status();
     models_ = new std::vector<SyntheticModel>(*std::move(models));
-    for (const auto& [name, method] : {std::pair{"views", "lfd"}, std::pair{"histograms", "dld"}}) {
+    // One collection with LFD, one without.
+    using Params = std::vector<std::pair<std::string, std::string>>;
+    const std::pair<std::string, Params> collections[] = {
+        {"views", {{"method", "lfd"}}},
+        {"histograms", {{"method", "dld"}, {"points", "64"}, {"vocabulary", "8"}}}};
+    for (const auto& [name, params] : collections) {
       grpc::ClientContext context;
       v1::CreateCollectionRequest request;
       request.set_name(name);
-      for (const auto& [param, value] : {std::pair{"method", method}, std::pair{"points", "64"},
-                                         std::pair{"vocabulary", "8"}}) {
-        if (std::string(method) == "lfd" && std::string(param) != "method") continue;
+      for (const auto& [param, value] : params) {
         v1::ParamValue* v = request.mutable_params()->add_values();
         v->set_name(param);
         v->set_value(value);
