@@ -95,53 +95,113 @@ MESHSEEK_TARGET_CLONES_AVX void ProjectVertices(std::size_t n,
   }
 }
 
+// Per vertex, as PixelSpans computes them for columns (x) and rows (y).
+struct PixelSpanArrays {
+  const int16_t* first_col;
+  const int16_t* last_col;
+  const int16_t* first_row;
+  const int16_t* last_row;
+};
+
+// The pixel centres k + 0.5 a vertex at screen coordinate p could bound: a
+// triangle's first column is the least of its corners' ceil(p - 0.5), its
+// last the greatest floor(p - 0.5) (rounding is monotone, so the minimum
+// commutes with it: the same columns as rounding the triangle's extremes).
+// Clamped to [0, size] and [-1, size - 1], which keeps every decision of the
+// cull (a first column past the image stays past the last one) and fits an
+// int16 for any image_size (at most 4096).
+MESHSEEK_TARGET_CLONES_AVX void PixelSpans(std::size_t n,
+                                           const double* __restrict p,
+                                           int size,
+                                           int16_t* __restrict first,
+                                           int16_t* __restrict last) {
+  const double beyond = size, end = size - 1;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double q = p[i] - 0.5;
+    first[i] = static_cast<int16_t>(std::min(std::max(std::ceil(q), 0.0), beyond));
+    last[i] = static_cast<int16_t>(std::min(std::max(std::floor(q), -1.0), end));
+  }
+}
+
+// The pixel centres of one triangle's box (x0..x1, y0..y1) that its closure
+// holds take its interpolated depth where it is the nearest surface so far
+// (largest depth; the earlier triangle on ties).
+inline void RasterizeTriangle(const double (&a)[3],
+                              const double (&b)[3],
+                              const double (&c)[3],
+                              int32_t index,
+                              int x0,
+                              int x1,
+                              int y0,
+                              int y1,
+                              int n,
+                              float* depth,
+                              uint8_t* mask,
+                              int32_t* face) {
+  const double ax = a[0], ay = a[1], bx = b[0], by = b[1], cx = c[0], cy = c[1];
+  const double area = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+  if (!(std::abs(area) > 1e-12)) return;  // edge-on, or degenerate
+  const double inverse = 1.0 / area;
+  for (int y = y0; y <= y1; ++y) {
+    const double sy = y + 0.5;
+    for (int x = x0; x <= x1; ++x) {
+      const double sx = x + 0.5;
+      // Barycentric weights as signed sub-areas over the whole.
+      const double wa = ((bx - sx) * (cy - sy) - (by - sy) * (cx - sx)) * inverse;
+      const double wb = ((cx - sx) * (ay - sy) - (cy - sy) * (ax - sx)) * inverse;
+      const double wc = 1.0 - wa - wb;
+      if (wa < 0 || wb < 0 || wc < 0) continue;
+      const auto z = static_cast<float>(wa * a[2] + wb * b[2] + wc * c[2]);
+      const std::size_t at = static_cast<std::size_t>(y) * n + x;
+      if (mask[at] == 0 || z > depth[at]) {
+        depth[at] = z;
+        mask[at] = 1;
+        if (face != nullptr) face[at] = index;
+      }
+    }
+  }
+}
+
 // Z-buffers `count` triangles of projected vertices (px, py, pz) into the
 // n x n image: a pixel takes the triangle nearest the camera (largest depth)
 // whose closure holds its centre, the first such in triangle order on ties.
-// Compiled wider too, for its rounding instructions (ceil and floor are
-// library calls on baseline x86-64).
+// Most triangles of a detailed mesh are smaller than a pixel and hold no
+// pixel centre, unpredictably: blocks of triangles are first culled without
+// branches from their corners' integer spans (PixelSpans), then the few left
+// are rasterised. Compiled wider too (gathers, and the rasteriser's rounding).
 MESHSEEK_TARGET_CLONES_AVX void Rasterize(const Triangle* triangles,
                                           std::size_t count,
                                           const double* px,
                                           const double* py,
                                           const double* pz,
+                                          const PixelSpanArrays& spans,
                                           int n,
                                           float* depth,
                                           uint8_t* mask,
                                           int32_t* face) {
-  for (std::size_t f = 0; f < count; ++f) {
-    const Triangle& t = triangles[f];
-    const double ax = px[t[0]], ay = py[t[0]], az = pz[t[0]];
-    const double bx = px[t[1]], by = py[t[1]], bz = pz[t[1]];
-    const double cx = px[t[2]], cy = py[t[2]], cz = pz[t[2]];
-    // Pixels whose centre can be inside: k + 0.5 in [min, max]. Most
-    // triangles of a detailed mesh are smaller than a pixel and hold none.
-    const int x0 = std::max(0, static_cast<int>(std::ceil(std::min({ax, bx, cx}) - 0.5)));
-    const int x1 = std::min(n - 1, static_cast<int>(std::floor(std::max({ax, bx, cx}) - 0.5)));
-    if (x0 > x1) continue;
-    const int y0 = std::max(0, static_cast<int>(std::ceil(std::min({ay, by, cy}) - 0.5)));
-    const int y1 = std::min(n - 1, static_cast<int>(std::floor(std::max({ay, by, cy}) - 0.5)));
-    if (y0 > y1) continue;
-    const double area = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
-    if (!(std::abs(area) > 1e-12)) continue;  // edge-on, or degenerate
-    const double inverse = 1.0 / area;
-    for (int y = y0; y <= y1; ++y) {
-      const double sy = y + 0.5;
-      for (int x = x0; x <= x1; ++x) {
-        const double sx = x + 0.5;
-        // Barycentric weights as signed sub-areas over the whole.
-        const double wa = ((bx - sx) * (cy - sy) - (by - sy) * (cx - sx)) * inverse;
-        const double wb = ((cx - sx) * (ay - sy) - (cy - sy) * (ax - sx)) * inverse;
-        const double wc = 1.0 - wa - wb;
-        if (wa < 0 || wb < 0 || wc < 0) continue;
-        const auto z = static_cast<float>(wa * az + wb * bz + wc * cz);
-        const std::size_t at = static_cast<std::size_t>(y) * n + x;
-        if (mask[at] == 0 || z > depth[at]) {
-          depth[at] = z;
-          mask[at] = 1;
-          if (face != nullptr) face[at] = static_cast<int32_t>(f);
-        }
-      }
+  constexpr int kBlock = 64;
+  for (std::size_t start = 0; start < count; start += kBlock) {
+    const int m = static_cast<int>(std::min<std::size_t>(kBlock, count - start));
+    int16_t box[4][kBlock];  // first and last column, first and last row
+    int kept[kBlock];
+    int num_kept = 0;
+    for (int j = 0; j < m; ++j) {
+      const Triangle& t = triangles[start + j];
+      box[0][j] = std::min({spans.first_col[t[0]], spans.first_col[t[1]], spans.first_col[t[2]]});
+      box[1][j] = std::max({spans.last_col[t[0]], spans.last_col[t[1]], spans.last_col[t[2]]});
+      box[2][j] = std::min({spans.first_row[t[0]], spans.first_row[t[1]], spans.first_row[t[2]]});
+      box[3][j] = std::max({spans.last_row[t[0]], spans.last_row[t[1]], spans.last_row[t[2]]});
+      kept[num_kept] = j;
+      num_kept += (box[0][j] <= box[1][j]) & (box[2][j] <= box[3][j]);
+    }
+    for (int q = 0; q < num_kept; ++q) {
+      const int j = kept[q];
+      const Triangle& t = triangles[start + j];
+      const double a[3] = {px[t[0]], py[t[0]], pz[t[0]]};
+      const double b[3] = {px[t[1]], py[t[1]], pz[t[1]]};
+      const double c[3] = {px[t[2]], py[t[2]], pz[t[2]]};
+      RasterizeTriangle(a, b, c, static_cast<int32_t>(start + j), box[0][j], box[1][j], box[2][j],
+                        box[3][j], n, depth, mask, face);
     }
   }
 }
@@ -164,8 +224,16 @@ ViewImage ViewRenderer::Render(const ViewCamera& frame) const {
   double* pz = py + count;
   ProjectVertices(count, x_.data(), y_.data(), z_.data(), frame.right, frame.up, frame.direction,
                   half, to_pixels, px, py, pz);
-  Rasterize(triangles_.data(), triangles_.size(), px, py, pz, n, image.depth.data(),
-            image.mask.data(), options_.record_faces ? image.face.data() : nullptr);
+  std::vector<int16_t> spans(4 * count);
+  int16_t* first_col = spans.data();
+  int16_t* last_col = first_col + count;
+  int16_t* first_row = last_col + count;
+  int16_t* last_row = first_row + count;
+  PixelSpans(count, px, n, first_col, last_col);
+  PixelSpans(count, py, n, first_row, last_row);
+  Rasterize(triangles_.data(), triangles_.size(), px, py, pz,
+            {first_col, last_col, first_row, last_row}, n, image.depth.data(), image.mask.data(),
+            options_.record_faces ? image.face.data() : nullptr);
   return image;
 }
 

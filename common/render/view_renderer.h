@@ -15,9 +15,10 @@
 // Rasterising. Every triangle (no back-face culling: soups and open meshes
 // have no consistent orientation) covers the pixels whose centres lie in it
 // (closed edges, so abutting triangles leave no gaps), with depth
-// interpolated linearly. Cost: one projection per vertex and view, then the
-// pixels of each triangle's bounding box. Deterministic and thread-safe
-// (Render is const).
+// interpolated linearly. Cost: one projection per vertex and view, an
+// integer pixel box per triangle (empty for most triangles of a detailed mesh,
+// which are smaller than a pixel), then the pixels of the boxes left.
+// Deterministic and thread-safe (Render is const).
 #ifndef MESHSEEK_COMMON_RENDER_VIEW_RENDERER_H_
 #define MESHSEEK_COMMON_RENDER_VIEW_RENDERER_H_
 
