@@ -53,6 +53,14 @@ struct FeatureMethodInfo {
   /// McGill and 6 on 40 take 26 s, first tier 76.65 against 76.86 on McGill
   /// and 50.32 against 50.52 on PSB train (bench/results/codebook.txt).
   int kmeans_iterations;
+  /// 0: a flat codebook, its words searched as KMeansOptions' auto
+  /// assignment chooses. n > 0: a vocabulary tree (KMeansOptions::kTree, 3
+  /// levels) whose search keeps n nodes a level. 4 for BF-DSIFT's 40,000
+  /// words: its codebook and encoding in 0.44 of the flat codebook's time on
+  /// McGill, the default fusion's first tier 94.10 against 94.15 (McGill) and
+  /// 61.64 against 61.9 (PSB train), the whole in-process eval 0.78 of the
+  /// time (bench/results/codebook.txt, 2026-12-07).
+  int kmeans_tree_probes;
   /// Its default weight in a fused collection (CollectionOptions::weights):
   /// 2 for the methods strongest on the development sets (BF-DSIFT, RLD-SIFT),
   /// 1.5 for LSF (with its square-rooted histograms), 1 for the others

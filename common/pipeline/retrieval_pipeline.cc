@@ -26,6 +26,20 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// The codebook the method's features were measured best with
+// (FeatureMethodInfo); a global method has none and keeps KMeansOptions'.
+void SetMethodCodebook(FeatureMethod method, KMeansOptions* kmeans) {
+  const FeatureMethodInfo& info = FeatureMethodInfoOf(method);
+  if (info.vocabulary == 0) return;
+  kmeans->num_centroids = info.vocabulary;
+  kmeans->max_points_per_centroid = info.kmeans_points_per_centroid;
+  kmeans->max_iterations = info.kmeans_iterations;
+  const KMeansOptions flat;
+  kmeans->assignment =
+      info.kmeans_tree_probes > 0 ? KMeansOptions::Assignment::kTree : flat.assignment;
+  kmeans->tree_probes = info.kmeans_tree_probes > 0 ? info.kmeans_tree_probes : flat.tree_probes;
+}
+
 }  // namespace
 
 RetrievalPipelineOptions::RetrievalPipelineOptions() {
@@ -34,19 +48,14 @@ RetrievalPipelineOptions::RetrievalPipelineOptions() {
   // centroid cost 0.2 points of R-precision against 256 (below the spread
   // between k-means seeds) and make k-means 2.5 times faster. Other methods
   // have their own measured figures (FeatureMethodInfo).
-  kmeans.num_centroids = FeatureMethodInfoOf(extractor.method).vocabulary;
-  kmeans.max_points_per_centroid = FeatureMethodInfoOf(extractor.method).kmeans_points_per_centroid;
-  kmeans.max_iterations = FeatureMethodInfoOf(extractor.method).kmeans_iterations;
+  SetMethodCodebook(extractor.method, &kmeans);
 }
 
 RetrievalPipelineOptions RetrievalPipelineOptions::ForMethod(FeatureMethod method) {
   RetrievalPipelineOptions options;
   options.extractor.method = method;
-  // A global method has no codebook: the (unused) default stays.
+  SetMethodCodebook(method, &options.kmeans);
   if (FeatureMethodInfoOf(method).vocabulary > 0) {
-    options.kmeans.num_centroids = FeatureMethodInfoOf(method).vocabulary;
-    options.kmeans.max_points_per_centroid = FeatureMethodInfoOf(method).kmeans_points_per_centroid;
-    options.kmeans.max_iterations = FeatureMethodInfoOf(method).kmeans_iterations;
     options.weighting.power = FeatureMethodInfoOf(method).histogram_power;
   }
   return options;
