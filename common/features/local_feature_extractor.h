@@ -54,13 +54,17 @@ struct FeatureMethodInfo {
   /// and 50.32 against 50.52 on PSB train (bench/results/codebook.txt).
   int kmeans_iterations;
   /// 0: a flat codebook, its words searched as KMeansOptions' auto
-  /// assignment chooses. n > 0: a vocabulary tree (KMeansOptions::kTree, 3
-  /// levels) whose search keeps n nodes a level. 4 for BF-DSIFT's 40,000
-  /// words: its codebook and encoding in 0.44 of the flat codebook's time on
-  /// McGill, the default fusion's first tier 94.10 against 94.15 (McGill) and
-  /// 61.64 against 61.9 (PSB train), the whole in-process eval 0.78 of the
-  /// time (bench/results/codebook.txt, 2026-12-07).
+  /// assignment chooses. n > 0: a vocabulary tree (KMeansOptions::kTree) of
+  /// kmeans_tree_depth levels whose search keeps n nodes a level. 4 for
+  /// BF-DSIFT's 40,000 words (3 levels): its codebook and encoding in 0.44 of
+  /// the flat codebook's time on McGill, the default fusion's first tier
+  /// 94.10 against 94.15 (McGill) and 61.64 against 61.9 (PSB train). 4 for
+  /// LSF's 2,000 words of 864 bytes (2 levels of ~45): its codebook 35 -> 6 s
+  /// on McGill, alone 0.7 lower first tier on McGill and the same on PSB
+  /// train, fused 94.27 against 94.10 (bench/results/codebook.txt).
   int kmeans_tree_probes;
+  /// Levels of that tree (KMeansOptions::tree_depth); 0 with a flat codebook.
+  int kmeans_tree_depth;
   /// Its default weight in a fused collection (CollectionOptions::weights):
   /// 2 for the methods strongest on the development sets (BF-DSIFT, RLD-SIFT),
   /// 1.5 for LSF (with its square-rooted histograms), 1 for the others

@@ -38,6 +38,7 @@ void SetMethodCodebook(FeatureMethod method, KMeansOptions* kmeans) {
   kmeans->assignment =
       info.kmeans_tree_probes > 0 ? KMeansOptions::Assignment::kTree : flat.assignment;
   kmeans->tree_probes = info.kmeans_tree_probes > 0 ? info.kmeans_tree_probes : flat.tree_probes;
+  kmeans->tree_depth = info.kmeans_tree_probes > 0 ? info.kmeans_tree_depth : flat.tree_depth;
 }
 
 }  // namespace
