@@ -90,7 +90,23 @@ ABSL_FLAG(int,
           meshseek::SyntheticBenchmarkOptions().models_per_class,
           "synth: models generated per class");
 ABSL_FLAG(int, montage_images, 48, "inspect: depth images in the montage");
-ABSL_FLAG(std::string, web_host, "0.0.0.0", "web: address the page is served on");
+ABSL_FLAG(std::string,
+          web_host,
+          meshseek::cli::WebGatewayOptions().host,
+          "web: address the page is served on; beyond loopback (0.0.0.0: every interface) it "
+          "needs --web_token_file and --web_tls_cert, or --web_open");
+ABSL_FLAG(std::string, web_tls_cert, "", "web: PEM certificate chain of the page's HTTPS");
+ABSL_FLAG(std::string, web_tls_key, "", "web: PEM private key of --web_tls_cert");
+ABSL_FLAG(std::string,
+          web_token_file,
+          "",
+          "web: file holding the bearer token every API call of the page must carry "
+          "(the coordinator's --token_file may serve)");
+ABSL_FLAG(bool,
+          web_open,
+          false,
+          "web: serve a non-loopback --web_host without token and TLS (a private network, or "
+          "behind a proxy that authenticates)");
 ABSL_FLAG(int, web_upload_mb, 64, "web: largest mesh file a browser may upload, in MiB");
 
 namespace meshseek::cli {
@@ -130,6 +146,10 @@ absl::StatusOr<CliFlags> ReadCliFlags(const flags::ParamFlags& params) {
   f.models_per_class = absl::GetFlag(FLAGS_models_per_class);
   f.montage_images = absl::GetFlag(FLAGS_montage_images);
   f.web.host = absl::GetFlag(FLAGS_web_host);
+  f.web.tls.cert_file = absl::GetFlag(FLAGS_web_tls_cert);
+  f.web.tls.key_file = absl::GetFlag(FLAGS_web_tls_key);
+  f.web.token_file = absl::GetFlag(FLAGS_web_token_file);
+  f.web.open = absl::GetFlag(FLAGS_web_open);
   f.web.max_upload_bytes = static_cast<std::size_t>(absl::GetFlag(FLAGS_web_upload_mb)) << 20;
   return f;
 }

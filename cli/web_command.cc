@@ -18,9 +18,10 @@ absl::Status RunWeb(const CliFlags& flags) {
   MESHSEEK_ASSIGN_OR_RETURN(auto client, CoordinatorClient::Open(flags.client));
   options.retry = client->retry();
   MESHSEEK_ASSIGN_OR_RETURN(auto gateway, WebGateway::Start(client->stub(), options));
-  std::printf("meshseek web: http://%s:%d/ ; Ctrl-C stops\n",
-              options.host == "0.0.0.0" ? "localhost" : options.host.c_str(),
-              gateway->port());
+  std::printf("meshseek web: %s://%s:%d/%s ; Ctrl-C stops\n",
+              options.tls.cert_file.empty() ? "http" : "https",
+              options.host == "0.0.0.0" ? "localhost" : options.host.c_str(), gateway->port(),
+              options.token_file.empty() ? "" : " (API calls need the bearer token)");
   std::fflush(stdout);
   rpc::WaitForTerminationSignal();
   gateway->Stop();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "common/rpc/client.h"
@@ -13,6 +14,7 @@
 #include "common/base/json.h"
 #include "common/base/status_macros.h"
 #include "common/geometry/mesh_io.h"
+#include "common/global/picture_silhouette.h"
 #include "common/render/thumbnail.h"
 #include "common/rpc/http_server.h"
 
@@ -94,6 +96,21 @@ Json ResultsJson(const v1::QueryResponse& answer) {
   return results;
 }
 
+// HTTPS with the certificate and key when given, plain HTTP otherwise. The
+// files are read here first so that a missing one is named.
+absl::StatusOr<std::unique_ptr<httplib::Server>> MakeServer(const rpc::TlsOptions& tls) {
+  if (tls.cert_file.empty()) return std::make_unique<httplib::Server>();
+  MESHSEEK_RETURN_IF_ERROR(rpc::ReadSecretFile(tls.cert_file, "--web_tls_cert").status());
+  MESHSEEK_RETURN_IF_ERROR(rpc::ReadSecretFile(tls.key_file, "--web_tls_key").status());
+  auto server = std::make_unique<httplib::SSLServer>(tls.cert_file.c_str(), tls.key_file.c_str());
+  if (!server->is_valid()) {
+    return absl::InvalidArgumentError(absl::StrCat("web: --web_tls_cert '", tls.cert_file,
+                                                   "' and --web_tls_key '", tls.key_file,
+                                                   "' are not a PEM certificate and its key"));
+  }
+  return server;
+}
+
 class Handlers {
  public:
   Handlers(v1::Coordinator::Stub* coordinator, const WebGatewayOptions& options)
@@ -156,7 +173,33 @@ class Handlers {
     if (absl::StatusOr<std::string> png = RenderThumbnailPng(*mesh); png.ok()) {
       about.Set("thumbnail", absl::StrCat("data:image/png;base64,", Base64Encode(*png)));
     }
-    RunQuery(request, &query, std::move(about), response);
+    RunQuery(request, &v1::Coordinator::Stub::Query, &query, std::move(about), response);
+  }
+
+  // A picture: sent on as its bytes; the coordinator decodes it (with the
+  // limits of DecodePicture) and names what is wrong with it.
+  void QueryWithImage(const httplib::Request& request, httplib::Response& response) const {
+    if (!request.has_file("image")) {
+      return ReplyError(response, absl::InvalidArgumentError("no image file in the request"));
+    }
+    const httplib::MultipartFormData& file = request.get_file_value("image");
+    const std::string name = std::filesystem::path(file.filename).filename().string();
+    if (file.content.empty()) {
+      return ReplyError(response, absl::InvalidArgumentError(absl::StrCat(name, ": empty file")));
+    }
+    if (file.content.size() > kMaxPictureFileBytes) {
+      return ReplyError(response, absl::ResourceExhaustedError(absl::StrCat(
+                                      name, ": a picture may hold at most ", kMaxPictureFileBytes,
+                                      " bytes, this one holds ", file.content.size())));
+    }
+    v1::QueryByImageRequest query;
+    query.set_collection(Param(request, "collection"));
+    query.set_image(file.content);
+    Json about = Json::MakeObject();
+    about.Set("name", name);
+    about.Set("summary", absl::StrCat("a picture of ", file.content.size() / 1024 + 1,
+                                      " KB, matched by its silhouette"));
+    RunQuery(request, &v1::Coordinator::Stub::QueryByImage, &query, std::move(about), response);
   }
 
   void QueryWithModel(const httplib::Request& request, httplib::Response& response) const {
@@ -169,7 +212,7 @@ class Handlers {
     Json about = Json::MakeObject();
     about.Set("name", query.model_id());
     about.Set("model_id", query.model_id());
-    RunQuery(request, &query, std::move(about), response);
+    RunQuery(request, &v1::Coordinator::Stub::Query, &query, std::move(about), response);
   }
 
   void Thumbnail(const httplib::Request& request, httplib::Response& response) const {
@@ -204,8 +247,11 @@ class Handlers {
                               options_.retry);
   }
 
+  // Query or QueryByImage with the page's collection and top_k.
+  template <typename Method, typename QueryRequest>
   void RunQuery(const httplib::Request& request,
-                v1::QueryRequest* query,
+                Method method,
+                QueryRequest* query,
                 Json about,
                 httplib::Response& response) const {
     if (query->collection().empty()) {
@@ -217,7 +263,7 @@ class Handlers {
     v1::QueryResponse answer;
     // A query changes nothing: retrying it while the coordinator restarts
     // is safe.
-    if (absl::Status s = Ask(&v1::Coordinator::Stub::Query, *query, &answer); !s.ok()) {
+    if (absl::Status s = Ask(method, *query, &answer); !s.ok()) {
       return ReplyError(response, s);
     }
     about.Set("features", static_cast<uint64_t>(answer.query_features()));
@@ -249,15 +295,45 @@ absl::Status WebGatewayOptions::Validate() const {
   if (call_deadline <= absl::ZeroDuration()) {
     return absl::InvalidArgumentError("web: call_deadline must be positive");
   }
+  if (tls.cert_file.empty() != tls.key_file.empty()) {
+    return absl::InvalidArgumentError("web: --web_tls_cert and --web_tls_key go together");
+  }
+  if (!open && !IsLoopback(host) && (token_file.empty() || tls.cert_file.empty())) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "web: --web_host=", host, " serves the API beyond this machine: give it a token "
+        "(--web_token_file) and TLS (--web_tls_cert, --web_tls_key), or --web_open on a private "
+        "network or behind a proxy that authenticates"));
+  }
   return absl::OkStatus();
+}
+
+bool IsLoopback(const std::string& host) {
+  return host == "localhost" || host == "::1" || absl::StartsWith(host, "127.");
 }
 
 absl::StatusOr<std::unique_ptr<WebGateway>> WebGateway::Start(v1::Coordinator::Stub* coordinator,
                                                               const WebGatewayOptions& options) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   std::unique_ptr<WebGateway> gateway(new WebGateway());
-  gateway->server_ = std::make_unique<httplib::Server>();
+  MESHSEEK_ASSIGN_OR_RETURN(gateway->server_, MakeServer(options.tls));
   httplib::Server& server = *gateway->server_;
+  std::string token;
+  if (!options.token_file.empty()) {
+    MESHSEEK_ASSIGN_OR_RETURN(token, rpc::ReadTokenFile(options.token_file, "--web_token_file"));
+  }
+  // Before the body is read: a caller without the token uploads nothing.
+  server.set_pre_routing_handler([token](const httplib::Request& q, httplib::Response& r) {
+    if (token.empty() || !absl::StartsWith(q.path, "/api/") ||
+        rpc::ConstantTimeEquals(q.get_header_value("Authorization"), "Bearer " + token)) {
+      return httplib::Server::HandlerResponse::Unhandled;
+    }
+    r.set_header("WWW-Authenticate", "Bearer realm=\"meshseek\"");
+    ReplyError(r, absl::UnauthenticatedError(
+                      q.has_header("Authorization")
+                          ? "wrong bearer token"
+                          : "this gateway wants a bearer token (Authorization: Bearer ...)"));
+    return httplib::Server::HandlerResponse::Handled;
+  });
   server.set_payload_max_length(options.max_upload_bytes);
   auto handlers = std::make_shared<const Handlers>(coordinator, options);
   using httplib::Request;
@@ -268,6 +344,8 @@ absl::StatusOr<std::unique_ptr<WebGateway>> WebGateway::Start(v1::Coordinator::S
               [handlers](const Request& q, Response& r) { handlers->QueryWithFile(q, r); });
   server.Get("/api/query",
              [handlers](const Request& q, Response& r) { handlers->QueryWithModel(q, r); });
+  server.Post("/api/query_image",
+              [handlers](const Request& q, Response& r) { handlers->QueryWithImage(q, r); });
   server.Get("/api/thumbnail",
              [handlers](const Request& q, Response& r) { handlers->Thumbnail(q, r); });
   server.Get(R"(/[A-Za-z0-9_.\-]*)",

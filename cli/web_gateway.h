@@ -8,7 +8,18 @@
 //                                           Query with the file's bytes
 //   GET  /api/query?collection=C&model_id=M&top_k=K
 //                                           Query with a model of C
+//   POST /api/query_image (multipart: collection, top_k, image = a PNG or JPEG)
+//                                           QueryByImage with the picture's bytes
 //   GET  /api/thumbnail?collection=C&model_id=M   GetThumbnail (image/png)
+//
+// Who reaches it (docs/operations.md, "The query page"): it listens on
+// loopback unless told otherwise. Exposed on another address, it wants TLS
+// (its own certificate and key) and a bearer token that every /api call
+// must carry as `Authorization: Bearer <token>` (401 otherwise, compared in
+// constant time; the page and its assets stay open so that a browser can ask
+// for the token), or an explicit `open` for a private network or an
+// authenticating proxy in front. The coordinator's own TLS and token are the
+// client's (CoordinatorClient), not these.
 //
 // A query answers {"query": {...}, "results": [{"model_id", "label",
 // "distance", "rank"}]}; an uploaded file's query carries its own thumbnail
@@ -29,6 +40,7 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "common/rpc/client.h"
+#include "common/rpc/credentials.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"
 
 namespace httplib {
@@ -38,8 +50,19 @@ class Server;
 namespace meshseek::cli {
 
 struct WebGatewayOptions {
-  /// Address to listen on ("0.0.0.0": every interface, as in a container).
-  std::string host = "0.0.0.0";
+  /// Address to listen on: loopback, so that only this machine reaches the
+  /// page. Any other ("0.0.0.0": every interface, as in a container) needs
+  /// TLS and token_file, or `open`.
+  std::string host = "127.0.0.1";
+  /// HTTPS: the certificate chain and private key (PEM) the gateway presents
+  /// (--web_tls_cert, --web_tls_key); both or neither. ca_file is not used.
+  rpc::TlsOptions tls;
+  /// File holding the bearer token every /api call must carry (printable
+  /// ASCII, surrounding whitespace trimmed; --web_token_file). Empty: none.
+  std::string token_file;
+  /// Serve a non-loopback host without TLS and a token (--web_open): only on
+  /// a private network or behind a proxy that authenticates.
+  bool open = false;
   /// Port to listen on, 0 for any free one (see WebGateway::port).
   int port = 8080;
   /// Largest request body (an uploaded mesh file), in bytes, 1 KiB..1 GiB.
@@ -55,6 +78,9 @@ struct WebGatewayOptions {
 
   absl::Status Validate() const;
 };
+
+/// Whether `host` names this machine only (localhost, 127.0.0.0/8, ::1).
+bool IsLoopback(const std::string& host);
 
 class WebGateway {
  public:

@@ -1,11 +1,16 @@
 // The gateway against a stand-in coordinator: routes, the JSON it answers,
-// the upload path (the file read here and sent on as bytes), the errors a
-// page shows, and the built-in assets.
+// the upload paths (a mesh read here and sent on as bytes, a picture sent on
+// as is), the errors a page shows, the built-in assets, and who may call it:
+// loopback by default, the bearer token, HTTPS with a throwaway certificate
+// (deploy/make-certs.sh, openssl).
 #include "cli/web_gateway.h"
 
 #include <gtest/gtest.h>
 #include <httplib.h>
 
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "common/geometry/mesh_io.h"
@@ -13,6 +18,7 @@
 #include "common/render/thumbnail.h"
 #include "common/rpc/client.h"
 #include "common/rpc/server.h"
+#include "absl/strings/str_cat.h"
 
 namespace meshseek::cli {
 namespace {
@@ -49,6 +55,13 @@ class FakeCoordinator final : public v1::Coordinator::Service {
     }
     return grpc::Status::OK;
   }
+  grpc::Status QueryByImage(grpc::ServerContext*,
+                            const v1::QueryByImageRequest* request,
+                            v1::QueryResponse* response) override {
+    last_image_ = request->image();
+    response->add_results()->set_model_id("m2");
+    return grpc::Status::OK;
+  }
   grpc::Status GetThumbnail(grpc::ServerContext*,
                             const v1::GetThumbnailRequest* request,
                             v1::Thumbnail* response) override {
@@ -57,6 +70,7 @@ class FakeCoordinator final : public v1::Coordinator::Service {
     return grpc::Status::OK;
   }
   std::string last_file_;
+  std::string last_image_;
   std::string last_model_;
 };
 
@@ -70,10 +84,17 @@ class WebGatewayTest : public ::testing::Test {
     server_ = *std::move(server);
     stub_ = v1::Coordinator::NewStub(
         rpc::MakeChannel("127.0.0.1:" + std::to_string(server_->port()), rpc::ChannelOptions()));
+    ASSERT_NO_FATAL_FAILURE(Restart(Options()));
+  }
+  static WebGatewayOptions Options() {
     WebGatewayOptions web;
-    web.host = "127.0.0.1";
     web.port = 0;
     web.max_upload_bytes = 64 << 10;
+    return web;
+  }
+  // A gateway with `web` in place of the running one, and a plain HTTP client of it.
+  void Restart(const WebGatewayOptions& web) {
+    if (gateway_) gateway_->Stop();
     auto gateway = WebGateway::Start(stub_.get(), web);
     ASSERT_TRUE(gateway.ok()) << gateway.status();
     gateway_ = *std::move(gateway);
@@ -91,6 +112,14 @@ class WebGatewayTest : public ::testing::Test {
         {"mesh", content, name, "application/octet-stream"},
     };
     return client_->Post("/api/query", form);
+  }
+
+  httplib::Result UploadPicture(const std::string& content) {
+    httplib::MultipartFormDataItems form = {
+        {"collection", "shapes", "", ""},
+        {"image", content, "chair.png", "image/png"},
+    };
+    return client_->Post("/api/query_image", form);
   }
 
   FakeCoordinator coordinator_;
@@ -112,6 +141,7 @@ std::string CubeOff() {
 
 TEST(WebGatewayOptionsTest, DefaultsAreValidAndBoundsAreChecked) {
   EXPECT_TRUE(WebGatewayOptions().Validate().ok());
+  EXPECT_TRUE(IsLoopback(WebGatewayOptions().host));
   WebGatewayOptions options;
   options.max_top_k = 0;
   EXPECT_EQ(options.Validate().code(), absl::StatusCode::kInvalidArgument);
@@ -206,6 +236,117 @@ TEST_F(WebGatewayTest, ServesThumbnailsAsPng) {
   EXPECT_EQ(found->get_header_value("Content-Type"), "image/png");
   EXPECT_EQ(found->body, "\x89PNG fake");
   EXPECT_EQ(client_->Get("/api/thumbnail?collection=shapes&model_id=zz")->status, 404);
+}
+
+TEST(WebGatewayOptionsTest, AnExposedGatewayNeedsATokenAndTlsOrOpen) {
+  EXPECT_TRUE(IsLoopback("localhost"));
+  EXPECT_TRUE(IsLoopback("127.0.0.2"));
+  EXPECT_TRUE(IsLoopback("::1"));
+  EXPECT_FALSE(IsLoopback("0.0.0.0"));
+  EXPECT_FALSE(IsLoopback("10.0.0.7"));
+  WebGatewayOptions options;
+  options.host = "0.0.0.0";
+  const absl::Status exposed = options.Validate();
+  EXPECT_EQ(exposed.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(exposed.message().find("--web_token_file"), std::string::npos) << exposed;
+  options.token_file = "/token";
+  EXPECT_FALSE(options.Validate().ok());  // a token in clear text across the network
+  options.tls = {"/tls.crt", "/tls.key", ""};
+  EXPECT_TRUE(options.Validate().ok());
+  options.tls.key_file.clear();
+  EXPECT_NE(options.Validate().message().find("--web_tls_key"), std::string::npos);
+  options = {};
+  options.host = "0.0.0.0";
+  options.open = true;
+  EXPECT_TRUE(options.Validate().ok());
+}
+
+TEST_F(WebGatewayTest, APictureIsSentOnAsItsBytes) {
+  const std::string png = "\x89PNG\r\n\x1a\n not decoded here";
+  auto answer = UploadPicture(png);
+  ASSERT_TRUE(answer);
+  ASSERT_EQ(answer->status, 200) << answer->body;
+  EXPECT_EQ(coordinator_.last_image_, png);
+  EXPECT_NE(answer->body.find(R"("model_id":"m2")"), std::string::npos) << answer->body;
+  EXPECT_NE(answer->body.find(R"("name":"chair.png")"), std::string::npos) << answer->body;
+
+  auto empty = UploadPicture("");
+  ASSERT_TRUE(empty);
+  EXPECT_EQ(empty->status, 400);
+  EXPECT_NE(empty->body.find("chair.png: empty file"), std::string::npos) << empty->body;
+  auto no_image = client_->Post("/api/query_image", httplib::MultipartFormDataItems{
+                                                        {"collection", "shapes", "", ""}});
+  ASSERT_TRUE(no_image);
+  EXPECT_EQ(no_image->status, 400);
+}
+
+// Writes `token` to a file of the test's temporary folder; its path.
+std::string TokenFile(const std::string& token) {
+  const std::string path = ::testing::TempDir() + "/meshseek_web_token";
+  std::ofstream(path) << token << "\n";
+  return path;
+}
+
+TEST_F(WebGatewayTest, ATokenIsWantedOnEveryApiCallButNotForThePage) {
+  WebGatewayOptions web = Options();
+  web.token_file = TokenFile("s3cret");
+  ASSERT_NO_FATAL_FAILURE(Restart(web));
+  auto bare = client_->Get("/api/collections");
+  ASSERT_TRUE(bare);
+  EXPECT_EQ(bare->status, 401);
+  EXPECT_EQ(bare->get_header_value("WWW-Authenticate"), "Bearer realm=\"meshseek\"");
+  EXPECT_NE(bare->body.find("bearer token"), std::string::npos) << bare->body;
+  auto wrong = client_->Get("/api/thumbnail?collection=shapes&model_id=m0",
+                            {{"Authorization", "Bearer s3cre"}});
+  ASSERT_TRUE(wrong);
+  EXPECT_EQ(wrong->status, 401);
+  EXPECT_NE(wrong->body.find("wrong bearer token"), std::string::npos) << wrong->body;
+  auto upload = Upload("cube.off", CubeOff());  // refused before it reaches the coordinator
+  ASSERT_TRUE(upload);
+  EXPECT_EQ(upload->status, 401);
+  EXPECT_TRUE(coordinator_.last_file_.empty());
+  EXPECT_EQ(client_->Get("/")->status, 200);
+  EXPECT_EQ(client_->Get("/app.js")->status, 200);
+
+  client_->set_bearer_token_auth("s3cret");
+  auto listed = client_->Get("/api/collections");
+  ASSERT_TRUE(listed);
+  EXPECT_EQ(listed->status, 200) << listed->body;
+  EXPECT_EQ(Upload("cube.off", CubeOff())->status, 200);
+
+  web.token_file = TokenFile("   \n");
+  EXPECT_EQ(WebGateway::Start(stub_.get(), web).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST_F(WebGatewayTest, ServesHttpsWithItsCertificate) {
+  const char* source = std::getenv("MESHSEEK_SOURCE_DIR");
+  ASSERT_NE(source, nullptr) << "run through ctest (MESHSEEK_SOURCE_DIR)";
+  const std::string dir = ::testing::TempDir() + "/meshseek_web_tls";
+  std::filesystem::remove_all(dir);
+  const std::string command = absl::StrCat(source, "/deploy/make-certs.sh ", dir, " >/dev/null");
+  ASSERT_EQ(std::system(command.c_str()), 0) << command << " (is openssl installed?)";
+  WebGatewayOptions web = Options();
+  web.host = "0.0.0.0";
+  web.tls = {dir + "/tls.crt", dir + "/tls.key", ""};
+  web.token_file = dir + "/token";
+  ASSERT_NO_FATAL_FAILURE(Restart(web));
+
+  httplib::SSLClient tls("localhost", gateway_->port());
+  tls.set_ca_cert_path((dir + "/ca.crt").c_str());
+  tls.enable_server_certificate_verification(true);
+  std::ifstream token_in(dir + "/token");
+  std::string token;
+  token_in >> token;
+  tls.set_bearer_token_auth(token.c_str());
+  auto listed = tls.Get("/api/collections");
+  ASSERT_TRUE(listed) << httplib::to_string(listed.error());
+  EXPECT_EQ(listed->status, 200) << listed->body;
+  EXPECT_FALSE(client_->Get("/api/collections"));  // plain HTTP gets no answer
+
+  web.tls.key_file = dir + "/absent.key";
+  auto missing = WebGateway::Start(stub_.get(), web);
+  EXPECT_NE(missing.status().message().find("--web_tls_key"), std::string::npos) << missing.status();
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

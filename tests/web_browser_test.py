@@ -3,14 +3,18 @@
 DevTools protocol, against `meshseek web` on an embedded stack holding the
 synthetic benchmark.
 
-It loads the page, uploads a model file through the page's file input,
-waits for the ranking and asserts on the DOM: the first result is the
+The gateway wants a bearer token: the page is refused (401), asks for it,
+and sends it from then on. It uploads a model file through the page's file
+input, waits for the ranking and asserts on the DOM: the first result is the
 uploaded model itself (distance 0: the same file gives the same features),
 every thumbnail loaded, most of the top results share its class; then it
-clicks a result (a query by model id) and uploads a broken file (a clear
-error naming it). With --screenshot FILE it saves the ranked page.
+clicks a result (a query by model id), uploads a picture (the model's own
+thumbnail, a shaded view on a plain background: a query by its silhouette)
+and a broken file (a clear error naming it). With --screenshot FILE it saves
+the ranked page of the mesh, with --picture_screenshot FILE the picture's.
 
   tests/web_browser_test.py --build build [--screenshot docs/images/web-query.png]
+      [--picture_screenshot docs/images/web-picture-query.png]
 
 Exit 0: passed; 77: Chromium or python3-websocket missing (skipped); other:
 failed, with the reason on stderr.
@@ -101,7 +105,9 @@ class DevTools:
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--build", default="build", help="meshseek's build folder")
-    parser.add_argument("--screenshot", help="save the ranked page here (PNG)")
+    parser.add_argument("--screenshot", help="save the mesh query's ranked page here (PNG)")
+    parser.add_argument("--picture_screenshot",
+                        help="save the picture query's ranked page here (PNG)")
     parser.add_argument("--keep", action="store_true", help="keep the temporary folder")
     args = parser.parse_args()
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -116,8 +122,9 @@ def main():
         data = os.path.join(work, "data")
         subprocess.run([meshseek, "synth", "--out", synth, "--models_per_class", "4"], check=True,
                        stdout=subprocess.DEVNULL)
+        # dld+lfd: LFD's views answer pictures.
         subprocess.run([meshseek, "eval", "--manifest", os.path.join(synth, "manifest.csv"),
-                        "--method", "dld", "--collection", "synthetic", "--data_dir", data,
+                        "--method", "dld+lfd", "--collection", "synthetic", "--data_dir", data,
                         "--out", os.path.join(work, "eval")], check=True, stdout=subprocess.DEVNULL)
         with open(os.path.join(synth, "manifest.csv")) as f:
             models = list(csv.DictReader(f))
@@ -125,7 +132,12 @@ def main():
         query_path = os.path.join(synth, query["path"])
 
         web_port = free_port()
-        web = subprocess.Popen([meshseek, "web", "--data_dir", data, "--port", str(web_port)],
+        token = "browser-test-token"
+        token_file = os.path.join(work, "token")
+        with open(token_file, "w") as f:
+            f.write(token + "\n")
+        web = subprocess.Popen([meshseek, "web", "--data_dir", data, "--port", str(web_port),
+                                "--web_token_file", token_file],
                                stdout=subprocess.PIPE, text=True)
         processes.append(web)
         line = web.stdout.readline()
@@ -142,6 +154,10 @@ def main():
         page = DevTools(devtools_port)
         page.call("Page.enable")
         page.call("Page.navigate", url=f"http://127.0.0.1:{web_port}/?collection=synthetic")
+        # Refused without the token: the page asks for it.
+        wait_for("the token form", lambda: page.js("document.querySelector('#token-form')?.hidden === false"))
+        page.js(f"document.querySelector('#token').value = {json.dumps(token)}; "
+                "document.querySelector('#token-form').requestSubmit()")
         wait_for("the collection list", lambda: page.js(
             "document.querySelector('#collection')?.value") == "synthetic")
 
@@ -176,6 +192,32 @@ def main():
             "document.querySelector('#query-name').textContent") == second)
         first = page.js("document.querySelector('.result').dataset.modelId")
         assert first == second, f"clicked {second}, first result {first}"
+
+        # A picture: the model's own thumbnail, fetched with the token.
+        thumbnail = urllib.request.Request(
+            f"http://127.0.0.1:{web_port}/api/thumbnail?collection=synthetic&model_id={query['id']}",
+            headers={"Authorization": f"Bearer {token}"})
+        picture = os.path.join(work, "picture.png")
+        with urllib.request.urlopen(thumbnail, timeout=30) as r, open(picture, "wb") as f:
+            f.write(r.read())
+        page.upload(picture)
+        state = page.wait_state()
+        error = page.js("document.querySelector('#error').textContent")
+        assert state == "results", f"the picture's query shows an error: {error}"
+        labels = page.js("[...document.querySelectorAll('.result')].map(r => r.dataset.label)")
+        assert labels and labels[0] == query["class"], \
+            f"picture of a {query['class']}: top labels {labels[:5]}"
+        assert "silhouette" in page.js("document.querySelector('#query-status').textContent")
+        wait_for("the picture and every thumbnail to load", lambda: page.js(
+            "[...document.querySelectorAll('.result img'), document.querySelector('#query-thumbnail')]"
+            ".every(i => i.complete && i.naturalWidth > 0)"), timeout=30)
+        print(f"web_browser_test: picture of {query['id']} ({query['class']}): "
+              f"top labels {labels[:5]}")
+        if args.picture_screenshot:
+            shot = page.call("Page.captureScreenshot", format="png")
+            with open(args.picture_screenshot, "wb") as f:
+                f.write(base64.b64decode(shot["data"]))
+            print(f"web_browser_test: wrote {args.picture_screenshot}")
 
         # A broken file: a clear error naming it, no results replaced.
         broken = os.path.join(work, "broken.off")

@@ -65,26 +65,25 @@ absl::Status CheckPair(const TlsOptions& tls, const char* side) {
   return absl::OkStatus();
 }
 
-// A token is sent as an HTTP/2 header value: printable ASCII without spaces
-// keeps it from being mangled or split on the way.
-absl::StatusOr<std::string> ReadToken(const std::string& path) {
-  absl::StatusOr<std::string> token = ReadSecretFile(path, "--token_file");
+}  // namespace
+
+absl::StatusOr<std::string> ReadTokenFile(const std::string& path, const std::string& what) {
+  // A token is sent as a header value (HTTP/2's or HTTP/1.1's): printable
+  // ASCII without spaces keeps it from being mangled or split on the way.
+  absl::StatusOr<std::string> token = ReadSecretFile(path, what);
   if (!token.ok()) return token.status();
   std::string trimmed(absl::StripAsciiWhitespace(*token));
   if (trimmed.empty()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--token_file '", path, "' holds only whitespace"));
+    return absl::InvalidArgumentError(absl::StrCat(what, " '", path, "' holds only whitespace"));
   }
   for (char c : trimmed) {
     if (c <= 0x20 || c >= 0x7f) {
       return absl::InvalidArgumentError(absl::StrCat(
-          "--token_file '", path, "': the token must be printable ASCII without spaces"));
+          what, " '", path, "': the token must be printable ASCII without spaces"));
     }
   }
   return trimmed;
 }
-
-}  // namespace
 
 bool ConstantTimeEquals(const std::string& a, const std::string& b) {
   // Every byte of the expected value `b` is visited whatever `a` holds; a
@@ -164,7 +163,7 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
   }
   std::shared_ptr<grpc::ServerCredentials> credentials = grpc::SslServerCredentials(ssl);
   if (!options.token_file.empty()) {
-    absl::StatusOr<std::string> token = ReadToken(options.token_file);
+    absl::StatusOr<std::string> token = ReadTokenFile(options.token_file, "--token_file");
     if (!token.ok()) return token.status();
     credentials->SetAuthMetadataProcessor(std::make_shared<BearerTokenProcessor>(*token));
   }
@@ -191,7 +190,7 @@ absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> MakeChannelCredentials
   }
   std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::SslCredentials(ssl);
   if (!options.token_file.empty()) {
-    absl::StatusOr<std::string> token = ReadToken(options.token_file);
+    absl::StatusOr<std::string> token = ReadTokenFile(options.token_file, "--token_file");
     if (!token.ok()) return token.status();
     credentials = grpc::CompositeChannelCredentials(credentials, grpc::AccessTokenCredentials(*token));
   }

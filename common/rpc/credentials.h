@@ -89,6 +89,10 @@ absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> MakeChannelCredentials
 /// NotFound / PermissionDenied / InvalidArgument (empty file) name both.
 absl::StatusOr<std::string> ReadSecretFile(const std::string& path, const std::string& what);
 
+/// The bearer token in `path` (ReadSecretFile), surrounding whitespace
+/// trimmed; InvalidArgument naming `what` and the file when nothing is left or
+/// it holds a space or a byte outside printable ASCII.
+absl::StatusOr<std::string> ReadTokenFile(const std::string& path, const std::string& what);
 /// Compares without an early exit, so the time taken says nothing about how
 /// much of a guess was right. Lengths may differ (then false).
 bool ConstantTimeEquals(const std::string& a, const std::string& b);

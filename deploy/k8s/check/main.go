@@ -77,7 +77,7 @@ func checkPod(where string, spec corev1.PodSpec, p *problems, help map[string]st
 		if web {
 			args = args[1:]
 		}
-		port, healthPort, metricsPort, tls := "", "", "", false
+		port, healthPort, metricsPort, tls, webTLS := "", "", "", false, false
 		for _, a := range args {
 			name, value, _ := strings.Cut(strings.TrimPrefix(a, "--"), "=")
 			if !strings.Contains(flags, "-"+name+" ") && !strings.Contains(flags, "-"+name+")") {
@@ -92,6 +92,8 @@ func checkPod(where string, spec corev1.PodSpec, p *problems, help map[string]st
 				metricsPort = value
 			case "tls_cert":
 				tls = true
+			case "web_tls_cert":
+				webTLS = true
 			}
 		}
 		ports := map[string]int32{}
@@ -108,6 +110,8 @@ func checkPod(where string, spec corev1.PodSpec, p *problems, help map[string]st
 					p.add("%s: container %s needs HTTP readiness and liveness probes", where, c.Name)
 				} else if probe.HTTPGet.Port.String() != port {
 					p.add("%s: probe on port %s, the page on %s", where, probe.HTTPGet.Port.String(), port)
+				} else if webTLS != (probe.HTTPGet.Scheme == corev1.URISchemeHTTPS) {
+					p.add("%s: probe scheme %q, but the page serves HTTPS: %v", where, probe.HTTPGet.Scheme, webTLS)
 				}
 			}
 			if c.Resources.Requests.Cpu().IsZero() || c.Resources.Limits.Memory().IsZero() {
@@ -217,8 +221,9 @@ func main() {
 			case *corev1.Service:
 				for _, sp := range o.Spec.Ports {
 					if o.Labels["app.kubernetes.io/component"] == "web" {
-						if sp.TargetPort.String() != "http" || sp.Port != 8080 {
-							p.add("%s: port %d -> %s, want 8080 -> http", where, sp.Port, sp.TargetPort.String())
+						// The page serves HTTPS (its certificate, a token on every API call).
+						if sp.TargetPort.String() != "https" || sp.Port != 8080 {
+							p.add("%s: port %d -> %s, want 8080 -> https", where, sp.Port, sp.TargetPort.String())
 						}
 						continue
 					}
