@@ -111,6 +111,27 @@ absl::StatusOr<std::unique_ptr<httplib::Server>> MakeServer(const rpc::TlsOption
   return server;
 }
 
+// A multipart file of a request: its own name (no folders) and its bytes.
+struct UploadedFile {
+  std::string name;
+  std::string content;
+};
+
+// The file `field` (httplib hands out a copy); InvalidArgument when it is
+// missing or empty.
+absl::StatusOr<UploadedFile> Upload(const httplib::Request& request, const std::string& field) {
+  if (!request.has_file(field)) {
+    return absl::InvalidArgumentError(absl::StrCat("no ", field, " file in the request"));
+  }
+  httplib::MultipartFormData file = request.get_file_value(field);
+  UploadedFile upload{std::filesystem::path(file.filename).filename().string(),
+                      std::move(file.content)};
+  if (upload.content.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(upload.name, ": empty file"));
+  }
+  return upload;
+}
+
 class Handlers {
  public:
   Handlers(v1::Coordinator::Stub* coordinator, const WebGatewayOptions& options)
@@ -145,18 +166,14 @@ class Handlers {
   // then sent as the file's bytes, which the coordinator reads again with
   // its own limits.
   void QueryWithFile(const httplib::Request& request, httplib::Response& response) const {
-    if (!request.has_file("mesh")) {
-      return ReplyError(response, absl::InvalidArgumentError("no mesh file in the request"));
-    }
-    const httplib::MultipartFormData& file = request.get_file_value("mesh");
-    const std::string name = std::filesystem::path(file.filename).filename().string();
-    if (file.content.empty()) {
-      return ReplyError(response, absl::InvalidArgumentError(absl::StrCat(name, ": empty file")));
-    }
+    absl::StatusOr<UploadedFile> upload = Upload(request, "mesh");
+    if (!upload.ok()) return ReplyError(response, upload.status());
+    const std::string& name = upload->name;
+    const std::string& content = upload->content;
     absl::StatusOr<MeshFormat> declared = MeshFormatFromPath(name);
     MeshReadReport report;
     absl::StatusOr<TriangleMesh> mesh =
-        ParseMesh(file.content,
+        ParseMesh(content,
                   name,
                   declared.ok() ? std::optional<MeshFormat>(*declared) : std::nullopt,
                   MeshReadOptions(),
@@ -165,7 +182,7 @@ class Handlers {
     v1::QueryRequest query;
     query.set_collection(Param(request, "collection"));
     v1::MeshFile* sent = query.mutable_mesh()->mutable_file();
-    sent->set_data(file.content);
+    sent->set_data(content);
     sent->set_name(name);
     Json about = Json::MakeObject();
     about.Set("name", name);
@@ -179,25 +196,21 @@ class Handlers {
   // A picture: sent on as its bytes; the coordinator decodes it (with the
   // limits of DecodePicture) and names what is wrong with it.
   void QueryWithImage(const httplib::Request& request, httplib::Response& response) const {
-    if (!request.has_file("image")) {
-      return ReplyError(response, absl::InvalidArgumentError("no image file in the request"));
-    }
-    const httplib::MultipartFormData& file = request.get_file_value("image");
-    const std::string name = std::filesystem::path(file.filename).filename().string();
-    if (file.content.empty()) {
-      return ReplyError(response, absl::InvalidArgumentError(absl::StrCat(name, ": empty file")));
-    }
-    if (file.content.size() > kMaxPictureFileBytes) {
+    absl::StatusOr<UploadedFile> upload = Upload(request, "image");
+    if (!upload.ok()) return ReplyError(response, upload.status());
+    const std::string& name = upload->name;
+    const std::string& content = upload->content;
+    if (content.size() > kMaxPictureFileBytes) {
       return ReplyError(response, absl::ResourceExhaustedError(absl::StrCat(
                                       name, ": a picture may hold at most ", kMaxPictureFileBytes,
-                                      " bytes, this one holds ", file.content.size())));
+                                      " bytes, this one holds ", content.size())));
     }
     v1::QueryByImageRequest query;
     query.set_collection(Param(request, "collection"));
-    query.set_image(file.content);
+    query.set_image(content);
     Json about = Json::MakeObject();
     about.Set("name", name);
-    about.Set("summary", absl::StrCat("a picture of ", file.content.size() / 1024 + 1,
+    about.Set("summary", absl::StrCat("a picture of ", content.size() / 1024 + 1,
                                       " KB, matched by its silhouette"));
     RunQuery(request, &v1::Coordinator::Stub::QueryByImage, &query, std::move(about), response);
   }
