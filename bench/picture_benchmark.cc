@@ -3,7 +3,7 @@
 // class, and what one query costs.
 //
 //   picture_benchmark --manifest FILE [--views 3] [--seed 1] [--picture_size 256]
-//                     [--scale_to 10000] [--threads 2]
+//                     [--scale_to 10000] [--threads 2] [--write_pictures DIR]
 //
 // Every model's LFD descriptor is extracted, as a collection with lfd stores
 // it. Each model is then drawn from --views seeded random directions (uniform
@@ -19,10 +19,14 @@
 // first tier and DCG per kind, the mean over views. The time per query is
 // the median of its whole path, decoding to ranking, with the collection as
 // it is and with its descriptors repeated to --scale_to models.
+// --write_pictures DIR also writes each model's first filled picture as
+// DIR/<id>.png (queries for bench/query_by_mesh.sh's picture mode).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
@@ -45,6 +49,7 @@ ABSL_FLAG(uint64_t, seed, 1, "seed of the views and the jitter");
 ABSL_FLAG(int, picture_size, 256, "side of the pictures in pixels");
 ABSL_FLAG(int, scale_to, 10000, "also time queries against the descriptors repeated to this many");
 ABSL_FLAG(int, threads, 2, "threads for extraction and queries");
+ABSL_FLAG(std::string, write_pictures, "", "write each model's first filled picture here");
 
 namespace meshseek {
 namespace {
@@ -139,6 +144,13 @@ int Run() {
   });
   std::printf("%zu models: descriptors and %zu pictures in %.1f s\n", n, pictures.size(),
               Seconds(start));
+  if (const std::string dir = absl::GetFlag(FLAGS_write_pictures); !dir.empty()) {
+    std::filesystem::create_directories(dir);
+    for (std::size_t m = 0; m < n; ++m) {
+      std::ofstream(dir + "/" + (*entries)[m].id + ".png", std::ios::binary)
+          << pictures[m * views * kKinds + kFilled];
+    }
+  }
 
   // Per kind and view, an N x N matrix: row q is q's picture against every
   // model (its own entry, the diagonal, is ignored by the evaluation).

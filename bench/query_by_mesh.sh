@@ -5,14 +5,18 @@
 # default fusion), then QUERIES of its models queried as files with
 # `meshseek query --top_k 10 --format json`, one after the other. Prints each
 # query's wall time (process start to ranked list out) and the coordinator's
-# stages (QueryResponse.timings), then their medians.
-#   bench/query_by_mesh.sh MANIFEST [METHOD] [QUERIES]
+# stages (QueryResponse.timings), then their medians. With PICTURES (a folder
+# of PNG or JPEG files, e.g. bench/picture_benchmark --write_pictures), the
+# queries are QUERIES of those pictures (`meshseek query --image`) instead;
+# METHOD must then hold lfd.
+#   bench/query_by_mesh.sh MANIFEST [METHOD] [QUERIES] [PICTURES]
 # Needs a Release build in ./build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 MANIFEST=${1:?usage: bench/query_by_mesh.sh MANIFEST [METHOD] [QUERIES]}
 METHOD=${2:-}
 QUERIES=${3:-10}
+PICTURES=${4:-}
 BIN=$PWD/build/cli/meshseek
 DATA=$(mktemp -d /tmp/meshseek-query-bench.XXXXXX)
 PORT=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])')
@@ -28,10 +32,16 @@ echo "ingest: $(python3 -c "print(f'{$(date +%s.%N) - $start:.1f}')") s"
 start=$(date +%s.%N)
 timeout 1800 "${CLIENT[@]}" build --collection bench 2>&1 | tail -1
 echo "build: $(python3 -c "print(f'{$(date +%s.%N) - $start:.1f}')") s"
-# The first QUERIES models of the manifest, as files (paths relative to it).
+# The first QUERIES models of the manifest, as files (paths relative to it),
+# or the first QUERIES pictures.
 dir=$(dirname "$MANIFEST")
-tail -n +2 "$MANIFEST" | head -n "$QUERIES" | while IFS=, read -r id label path; do
-  file=$path; [[ $file = /* ]] || file=$dir/$path
+if [ -n "$PICTURES" ]; then
+  find "$PICTURES" -maxdepth 1 -type f \( -name '*.png' -o -name '*.jpg' \) | sort | head -n "$QUERIES" |
+    while read -r file; do echo "$(basename "$file"),-,--image=$file"; done
+else
+  tail -n +2 "$MANIFEST" | head -n "$QUERIES"
+fi | while IFS=, read -r id label path; do
+  file=$path; [[ $file = /* || $file = --image=* ]] || file=$dir/$path
   t0=$(date +%s.%N)
   json=$("${CLIENT[@]}" query --collection bench --top_k 10 --format json "$file")
   t1=$(date +%s.%N)
