@@ -7,7 +7,9 @@
         --folder out/synthetic --param points=256 --param vocabulary=64
 
 Labels come from FOLDER/manifest.csv (id,class,path) when there is one. The
-query is the first model of the folder unless --query names a mesh file.
+query is the first model of the folder unless --query names a mesh file. A
+collection with lfd (--method dld+lfd, or the default fusion) is also queried
+by a picture: --picture FILE (PNG or JPEG), or the query model's own thumbnail.
 """
 
 import argparse
@@ -28,6 +30,7 @@ def main():
     parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                         help="a pipeline parameter (meshseek --help lists them); repeatable")
     parser.add_argument("--query", help="mesh file to query with (default: the folder's first)")
+    parser.add_argument("--picture", help="PNG or JPEG to query with as well (needs lfd)")
     parser.add_argument("--top_k", type=int, default=5)
     parser.add_argument("--tls_ca", help="CA bundle (PEM) to verify the server with")
     parser.add_argument("--token_file", help="file holding the bearer token (needs --tls_ca)")
@@ -61,9 +64,23 @@ def main():
         response = client.query(args.collection, query, top_k=args.top_k)
         print(f"query {query} (model {model_id}, class {label}): "
               f"{response.query_features} features; nearest:")
-        print(f"{'rank':>4}  {'model':<12} {'label':<12} distance")
-        for rank, r in enumerate(response.results, 1):
-            print(f"{rank:>4}  {r.model_id:<12} {r.label:<12} {r.distance:.6g}")
+        print_ranking(response)
+
+        if args.picture or "lfd" in args.method.split("+"):
+            picture = args.picture
+            if not picture:  # the query model's thumbnail, as a picture of it
+                picture = os.path.join(args.folder, f"thumbnail-{model_id}.png")
+                with open(picture, "wb") as f:
+                    f.write(client.thumbnail(args.collection, model_id))
+            response = client.query_by_image(args.collection, picture, top_k=args.top_k)
+            print(f"picture {picture}: nearest:")
+            print_ranking(response)
+
+
+def print_ranking(response):
+    print(f"{'rank':>4}  {'model':<12} {'label':<12} distance")
+    for rank, r in enumerate(response.results, 1):
+        print(f"{rank:>4}  {r.model_id:<12} {r.label:<12} {r.distance:.6g}")
 
 
 if __name__ == "__main__":

@@ -4,8 +4,9 @@
 # writes a small synthetic benchmark (`meshseek synth`), starts `meshseek serve`
 # on a free port (--port 0: it prints the port it got) with a temporary data
 # folder, runs python/example.py against it with PYTHONPATH=GENERATED_DIR and
-# checks that the nearest model to the query is the query itself or of its
-# class. The server is stopped with SIGTERM and the folder removed whatever
+# checks that the nearest model to the query, by its mesh and then by its
+# thumbnail as a picture (the collection is dld+lfd), is the query itself or
+# of its class. The server is stopped with SIGTERM and the folder removed whatever
 # happens. Exits 77 (ctest: skipped) only when PYTHON has no grpc or protobuf.
 set -euo pipefail
 CLI=$1
@@ -50,14 +51,17 @@ done
 # The query: the manifest's 5th model (id,class,path).
 IFS=, read -r QID QCLASS QPATH < <(sed -n 6p "$T/syn/manifest.csv")
 PYTHONPATH=$GENERATED timeout 90 "$PY" "$HERE/example.py" --server "$ADDR" --folder "$T/syn" \
-  --collection example-test --query "$T/syn/$QPATH" --top_k 5 \
+  --collection example-test --query "$T/syn/$QPATH" --top_k 5 --method dld+lfd \
   --param points=256 --param vocabulary=32 | tee "$T/example.log" || fail "example.py"
-FIRST=$(awk '$1 == "1" { print $2, $3 }' "$T/example.log")
-read -r ID LABEL <<<"$FIRST" || fail "example.py printed no rank 1"
-[ "$ID" = "$QID" ] || [ "$LABEL" = "$QCLASS" ] ||
-  fail "nearest to model $QID ($QCLASS) is model $ID ($LABEL)"
+# Two rankings: the mesh's, then its thumbnail's as a picture.
+FIRSTS=$(awk '$1 == "1" { print $2, $3 }' "$T/example.log")
+[ "$(wc -l <<<"$FIRSTS")" = 2 ] || fail "example.py printed $(wc -l <<<"$FIRSTS") rank-1 lines, not 2"
+while read -r ID LABEL; do
+  [ "$ID" = "$QID" ] || [ "$LABEL" = "$QCLASS" ] ||
+    fail "nearest to model $QID ($QCLASS) is model $ID ($LABEL)"
+done <<<"$FIRSTS"
 
 kill -TERM "$SERVER"
 wait "$SERVER" || fail "meshseek serve exited with status $? after SIGTERM"
 SERVER=
-echo "example_test: OK (nearest to model $QID of class $QCLASS: model $ID of class $LABEL)"
+echo "example_test: OK (nearest to model $QID of class $QCLASS by mesh, then by picture: $(tr '\n' ';' <<<"$FIRSTS"))"

@@ -180,6 +180,12 @@ class Client:
                                   top_k=top_k, candidates=candidates)
         return self.stub.Query(request, timeout=timeout)
 
+    def thumbnail(self, collection, model_id, timeout=30.0):
+        """The PNG bytes of a model's thumbnail (a shaded view on a
+        transparent background, 128 x 128)."""
+        request = pb.GetThumbnailRequest(collection=collection, model_id=model_id)
+        return self.stub.GetThumbnail(request, timeout=timeout).png
+
     def query_by_image(self, collection, path, top_k=10, timeout=60.0):
         """Ranks the models of `collection` by how much they look like the
         picture in the PNG or JPEG file `path` (a photo, rendering or drawing
