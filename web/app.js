@@ -80,7 +80,9 @@ async function showThumbnail(img, url) {
     return;
   }
   const response = await fetch(url, authorized());
-  if (response.ok) img.src = URL.createObjectURL(await response.blob());
+  if (!response.ok) return;
+  img.onload = () => URL.revokeObjectURL(img.src);  // the image keeps its pixels
+  img.src = URL.createObjectURL(await response.blob());
 }
 
 function render(answer, startedAt, picture) {
