@@ -335,9 +335,12 @@ absl::StatusOr<std::unique_ptr<WebGateway>> WebGateway::Start(v1::Coordinator::S
     MESHSEEK_ASSIGN_OR_RETURN(token, rpc::ReadTokenFile(options.token_file, "--web_token_file"));
   }
   // Before the body is read: a caller without the token uploads nothing.
+  // The scheme's name is case-insensitive (RFC 6750), the token is not.
   server.set_pre_routing_handler([token](const httplib::Request& q, httplib::Response& r) {
+    const std::string given = q.get_header_value("Authorization");
     if (token.empty() || !absl::StartsWith(q.path, "/api/") ||
-        rpc::ConstantTimeEquals(q.get_header_value("Authorization"), "Bearer " + token)) {
+        (absl::StartsWithIgnoreCase(given, "Bearer ") &&
+         rpc::ConstantTimeEquals(given.substr(7), token))) {
       return httplib::Server::HandlerResponse::Unhandled;
     }
     r.set_header("WWW-Authenticate", "Bearer realm=\"meshseek\"");

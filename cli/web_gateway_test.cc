@@ -313,6 +313,8 @@ TEST_F(WebGatewayTest, ATokenIsWantedOnEveryApiCallButNotForThePage) {
   ASSERT_TRUE(listed);
   EXPECT_EQ(listed->status, 200) << listed->body;
   EXPECT_EQ(Upload("cube.off", CubeOff())->status, 200);
+  EXPECT_EQ(client_->Get("/api/collections", {{"Authorization", "bearer s3cret"}})->status, 200);
+  EXPECT_EQ(client_->Get("/api/collections", {{"Authorization", "Bearer S3CRET"}})->status, 401);
 
   web.token_file = TokenFile("   \n");
   EXPECT_EQ(WebGateway::Start(stub_.get(), web).status().code(), absl::StatusCode::kInvalidArgument);
