@@ -5,10 +5,6 @@
 // second, every valid one accepted, and the server must still serve, with
 // resident memory under 1 GB, at the end.
 #include <signal.h>
-#include <sys/socket.h>
-#include <sys/wait.h>
-#include <netinet/in.h>
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <cstdint>
@@ -24,10 +20,10 @@
 #include "absl/time/clock.h"
 #include "common/base/test_env.h"
 #include "common/rpc/client.h"
-#include "common/rpc/free_port.h"
 #include "gmock/gmock.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "gtest/gtest.h"
+#include "tests/server_process.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"
 
 namespace meshseek {
@@ -168,39 +164,13 @@ class HostileInputTest : public ::testing::Test {
     dir_ = ::testing::TempDir() + "/meshseek_hostile";
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_ + "/files");
-    port_ = rpc::FreeLoopbackPort();
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int fd = ::open((dir_ + "/serve.log").c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-      dup2(fd, 1);
-      dup2(fd, 2);
-      const std::string data = "--data_dir=" + dir_ + "/data";
-      const std::string port = absl::StrCat("--port=", port_);
-      execl(MESHSEEK_CLI_PATH, MESHSEEK_CLI_PATH, "serve", data.c_str(), port.c_str(),
-            "--threads=2", static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    channel_ = rpc::MakeChannel(absl::StrCat("127.0.0.1:", port_));
+    server_ = std::make_unique<ServerProcess>(
+        std::vector<std::string>{MESHSEEK_CLI_PATH, "serve", "--data_dir=" + dir_ + "/data",
+                                 "--threads=2"},
+        dir_ + "/serve.log", "meshseek serving on 127.0.0.1:");
+    ASSERT_TRUE(server_->WaitServing()) << "meshseek serve did not start";
+    channel_ = rpc::MakeChannel(absl::StrCat("127.0.0.1:", server_->port()));
     stub_ = v1::Coordinator::NewStub(channel_);
-    auto health = grpc::health::v1::Health::NewStub(channel_);
-    for (int i = 0; i < 400; ++i) {
-      grpc::ClientContext context;
-      rpc::SetDeadline(&context, absl::Milliseconds(500));
-      grpc::health::v1::HealthCheckRequest request;
-      grpc::health::v1::HealthCheckResponse response;
-      if (health->Check(&context, request, &response).ok() &&
-          response.status() == grpc::health::v1::HealthCheckResponse::SERVING) {
-        return;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    FAIL() << "meshseek serve did not start; see " << dir_ << "/serve.log";
-  }
-  void TearDown() override {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
   }
 
   // One model as MeshFile in its own ingest stream: the stream's status.
@@ -234,8 +204,7 @@ class HostileInputTest : public ::testing::Test {
   }
 
   std::string dir_;
-  int port_ = 0;
-  pid_t pid_ = -1;
+  std::unique_ptr<ServerProcess> server_;
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::Coordinator::Stub> stub_;
 };
@@ -308,7 +277,7 @@ TEST_F(HostileInputTest, BadFilesAreRefusedNamedAndQuicklyValidOnesServedMemoryS
     ASSERT_TRUE(stub_->GetCollection(&context, get, &collection).ok());
     EXPECT_EQ(collection.models(), ValidFiles().size());
   }
-  const double rss = ResidentMiB(pid_);
+  const double rss = ResidentMiB(server_->pid());
   EXPECT_GT(rss, 0);
   EXPECT_LT(rss, 1024) << "MiB resident after the corpus";
   std::printf("meshseek serve resident after the corpus: %.0f MiB\n", rss);

@@ -3,11 +3,7 @@
 // of an extract worker, of the index and of the coordinator loses no
 // acknowledged model; bad input gets the right status code and a message
 // naming the problem, and the servers keep serving.
-#include <fcntl.h>
-#include <netinet/in.h>
 #include <signal.h>
-#include <sys/socket.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -28,13 +24,13 @@
 #include "common/pipeline/pipeline_params.h"
 #include "common/rpc/client.h"
 #include "common/wire/convert.h"
-#include "common/rpc/free_port.h"
 #include "common/rpc/status.h"
 #include "common/store/sqlite_db.h"
 #include "common/synth/synthetic_benchmark.h"
 #include "gmock/gmock.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "gtest/gtest.h"
+#include "tests/server_process.h"
 #include "meshseek/v1/codebook.grpc.pb.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"
 #include "meshseek/v1/extract.grpc.pb.h"
@@ -64,131 +60,68 @@ double CpuSeconds(pid_t pid) {
 
 std::string Address(int port) { return absl::StrCat("127.0.0.1:", port); }
 
-// A server binary running as a child process.
-class Server {
+// A service binary of this build, its log in the test's folder.
+class Server : public ServerProcess {
  public:
-  Server(const std::string& role, std::vector<std::string> args, int port) : port_(port) {
-    args_.push_back(std::string(MESHSEEK_SERVICES_DIR) + "/meshseek-" + role);
-    args_.push_back(absl::StrCat("--port=", port));
-    args_.push_back("--grace_period=1s");
-    for (auto& a : args) args_.push_back(std::move(a));
-    log_ = ::testing::TempDir() + "/" + role + "-" + std::to_string(port) + ".log";
-    Start();
-  }
-  ~Server() { Kill(SIGKILL); }
-
-  void Start() {
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int fd = ::open(log_.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-      dup2(fd, 1);
-      dup2(fd, 2);
-      std::vector<char*> argv;
-      for (auto& a : args_) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(argv[0], argv.data());
-      _exit(127);
-    }
-  }
-  // Flags of the next Start.
-  void AddArgs(const std::vector<std::string>& args) {
-    args_.insert(args_.end(), args.begin(), args.end());
-  }
-  void Kill(int signal) {
-    if (pid_ <= 0) return;
-    ::kill(pid_, signal);
-    waitpid(pid_, nullptr, 0);
-    pid_ = -1;
-  }
-  // Waits until the health service says SERVING.
-  bool WaitServing() const {
-    auto stub = grpc::health::v1::Health::NewStub(
-        grpc::CreateChannel(Address(port_), grpc::InsecureChannelCredentials()));
-    // By the clock, not by tries: a refused connection fails at once, and a
-    // restart after kill -9 under TSan on a loaded machine takes seconds.
-    const absl::Time end = absl::Now() + absl::Seconds(90);
-    while (absl::Now() < end) {
-      grpc::ClientContext context;
-      rpc::SetDeadline(&context, absl::Milliseconds(500));
-      grpc::health::v1::HealthCheckRequest request;
-      grpc::health::v1::HealthCheckResponse response;
-      if (stub->Check(&context, request, &response).ok() &&
-          response.status() == grpc::health::v1::HealthCheckResponse::SERVING) {
-        return true;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    return false;
-  }
-  // Waits up to `within` for the process to exit by itself; its exit code,
-  // or -1 if it is still running.
-  int WaitExit(absl::Duration within) {
-    const absl::Time end = absl::Now() + within;
-    while (pid_ > 0 && absl::Now() < end) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = -1;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    return -1;
-  }
-  int port() const { return port_; }
-  pid_t pid() const { return pid_; }
+  Server(const std::string& role, std::vector<std::string> flags)
+      : ServerProcess(Argv(role, std::move(flags)), Log(role)) {}
 
  private:
-  std::vector<std::string> args_;
-  std::string log_;
-  int port_;
-  pid_t pid_ = -1;
+  static std::vector<std::string> Argv(const std::string& role, std::vector<std::string> flags) {
+    std::vector<std::string> argv = {std::string(MESHSEEK_SERVICES_DIR) + "/meshseek-" + role,
+                                     "--grace_period=1s"};
+    argv.insert(argv.end(), flags.begin(), flags.end());
+    return argv;
+  }
+  static std::string Log(const std::string& role) {
+    static int started = 0;
+    return absl::StrCat(::testing::TempDir(), "/", role, "-", ++started, ".log");
+  }
 };
 
 // The whole stack: resample, `extract_workers` extract workers, codebook,
-// `index_shards` index servers and coordinator, state under `dir`.
+// `index_shards` index servers and coordinator, state under `dir`. The
+// coordinator starts in the first WaitServing, once the others have said
+// their ports.
 class Stack {
  public:
   Stack(const std::string& dir, int extract_workers, int max_pending = 512, int index_shards = 1,
-        const std::vector<std::string>& coordinator_flags = {})
-      : dir_(dir) {
-    resample_ = std::make_unique<Server>("resample", std::vector<std::string>{}, rpc::FreeLoopbackPort());
-    std::string targets;
+        const std::vector<std::string>& coordinator_flags = {}) {
+    resample_ = std::make_unique<Server>("resample", std::vector<std::string>{});
     for (int w = 0; w < extract_workers; ++w) {
-      extract_.push_back(std::make_unique<Server>(
-          "extract", std::vector<std::string>{"--workers=1"}, rpc::FreeLoopbackPort()));
-      absl::StrAppend(&targets, targets.empty() ? "" : ",", Address(extract_.back()->port()));
+      extract_.push_back(std::make_unique<Server>("extract", std::vector<std::string>{"--workers=1"}));
     }
-    codebook_ = std::make_unique<Server>(
-        "codebook", std::vector<std::string>{"--data_dir=" + dir + "/codebook"}, rpc::FreeLoopbackPort());
-    std::string shards;
+    codebook_ = std::make_unique<Server>("codebook",
+                                         std::vector<std::string>{"--data_dir=" + dir + "/codebook"});
     for (int s = 0; s < index_shards; ++s) {
       index_.push_back(std::make_unique<Server>(
-          "index", std::vector<std::string>{absl::StrCat("--data_dir=", dir, "/index", s)},
-          rpc::FreeLoopbackPort()));
-      absl::StrAppend(&shards, shards.empty() ? "" : ",", Address(index_.back()->port()));
+          "index", std::vector<std::string>{absl::StrCat("--data_dir=", dir, "/index", s)}));
     }
-    coordinator_args_ = {"--data_dir=" + dir + "/coordinator",
-                         "--resample=" + Address(resample_->port()),
-                         "--extract=ipv4:" + targets,
-                         "--codebook=" + Address(codebook_->port()),
-                         "--index=" + shards,
-                         absl::StrCat("--max_in_flight=", extract_workers),
-                         absl::StrCat("--max_pending=", max_pending)};
-    coordinator_args_.insert(coordinator_args_.end(), coordinator_flags.begin(),
-                             coordinator_flags.end());
-    coordinator_ = std::make_unique<Server>("coordinator", coordinator_args_, rpc::FreeLoopbackPort());
+    coordinator_flags_ = {"--data_dir=" + dir + "/coordinator",
+                          absl::StrCat("--max_in_flight=", extract_workers),
+                          absl::StrCat("--max_pending=", max_pending)};
+    coordinator_flags_.insert(coordinator_flags_.end(), coordinator_flags.begin(),
+                              coordinator_flags.end());
   }
   bool WaitServing() {
-    for (Server* s : {resample_.get(), codebook_.get(), coordinator_.get()}) {
+    std::vector<Server*> servers = {resample_.get(), codebook_.get()};
+    for (auto& s : index_) servers.push_back(s.get());
+    for (auto& s : extract_) servers.push_back(s.get());
+    for (Server* s : servers) {
       if (!s->WaitServing()) return false;
     }
-    for (auto& i : index_) {
-      if (!i->WaitServing()) return false;
+    if (coordinator_ == nullptr) {
+      std::string targets, shards;
+      for (auto& e : extract_) absl::StrAppend(&targets, targets.empty() ? "" : ",", Address(e->port()));
+      for (auto& i : index_) absl::StrAppend(&shards, shards.empty() ? "" : ",", Address(i->port()));
+      std::vector<std::string> flags = {"--resample=" + Address(resample_->port()),
+                                        "--extract=ipv4:" + targets,
+                                        "--codebook=" + Address(codebook_->port()),
+                                        "--index=" + shards};
+      flags.insert(flags.end(), coordinator_flags_.begin(), coordinator_flags_.end());
+      coordinator_ = std::make_unique<Server>("coordinator", flags);
     }
-    for (auto& e : extract_) {
-      if (!e->WaitServing()) return false;
-    }
-    return true;
+    return coordinator_->WaitServing();
   }
   std::unique_ptr<v1::Coordinator::Stub> Coordinator() const {
     return v1::Coordinator::NewStub(rpc::MakeChannel(Address(coordinator_->port())));
@@ -199,10 +132,9 @@ class Stack {
   Server& codebook() { return *codebook_; }
 
  private:
-  std::string dir_;
   std::unique_ptr<Server> resample_, codebook_, coordinator_;
   std::vector<std::unique_ptr<Server>> extract_, index_;
-  std::vector<std::string> coordinator_args_;
+  std::vector<std::string> coordinator_flags_;
 };
 
 // Small parameters: the test is about the system, not accuracy.
@@ -401,7 +333,7 @@ TEST_F(ServicesTest, KilledExtractWorkerLosesNothingAndResultEqualsInProcess) {
   Stack stack(*dir_ + "/kill-extract", 2, /*max_pending=*/8);
   ASSERT_TRUE(stack.WaitServing());
   auto stub = stack.Coordinator();
-  ASSERT_TRUE(CreateCollection(stub.get(), "synthetic").ok());
+  ASSERT_EQ(CreateCollection(stub.get(), "synthetic"), absl::OkStatus());
   std::set<std::string> jobs;
   const std::size_t n = models_->size();
   const std::size_t acked = Ingest(stub.get(), "synthetic", 0, n, &jobs, [&](std::size_t a) {
@@ -434,7 +366,7 @@ TEST_F(ServicesTest, KilledAndRestartedIndexAndCoordinatorLoseNoAcknowledgedMode
   Stack stack(*dir_ + "/kill-state", 1);
   ASSERT_TRUE(stack.WaitServing());
   auto stub = stack.Coordinator();
-  ASSERT_TRUE(CreateCollection(stub.get(), "synthetic").ok());
+  ASSERT_EQ(CreateCollection(stub.get(), "synthetic"), absl::OkStatus());
   const std::size_t n = models_->size();
   std::set<std::string> jobs;
   // Half the models, then the coordinator dies right after acknowledging.
@@ -475,14 +407,14 @@ TEST_F(ServicesTest, BadInputGetsTheRightCodeANamedProblemAndServersKeepServing)
   Stack stack(*dir_ + "/bad-input", 1);
   ASSERT_TRUE(stack.WaitServing());
   auto stub = stack.Coordinator();
-  ASSERT_TRUE(CreateCollection(stub.get(), "good").ok());
+  ASSERT_EQ(CreateCollection(stub.get(), "good"), absl::OkStatus());
   // Parameters that name no method: the default fusion, re-ranked (stored
   // with every value, the method first); legacy fields alone keep dld.
   {
-    ASSERT_TRUE(CreateCollection(stub.get(), "default", v1::PipelineParams()).ok());
+    ASSERT_EQ(CreateCollection(stub.get(), "default", v1::PipelineParams()), absl::OkStatus());
     v1::PipelineParams legacy;
     legacy.set_vocabulary(24);
-    ASSERT_TRUE(CreateCollection(stub.get(), "legacy", legacy).ok());
+    ASSERT_EQ(CreateCollection(stub.get(), "legacy", legacy), absl::OkStatus());
     for (const auto& [name, method] : std::vector<std::pair<std::string, std::string>>{
              {"default", kDefaultCollectionMethods}, {"legacy", "dld"}}) {
       grpc::ClientContext context;
@@ -592,7 +524,7 @@ TEST_F(ServicesTest, BadInputGetsTheRightCodeANamedProblemAndServersKeepServing)
 TEST(ServicesLoadTest, SixtyFourConcurrentAddModelCallsToTheIndexAllSucceed) {
   const std::string dir = ::testing::TempDir() + "/meshseek_index_burst";
   std::filesystem::remove_all(dir);
-  Server index("index", {"--data_dir=" + dir}, rpc::FreeLoopbackPort());
+  Server index("index", {"--data_dir=" + dir});
   ASSERT_TRUE(index.WaitServing());
   auto stub = v1::Index::NewStub(rpc::MakeChannel(Address(index.port())));
   constexpr int kCalls = 64;
@@ -641,7 +573,7 @@ TEST_F(ServicesTest, AGlobalDescriptorCollectionSurvivesKillsAndEqualsInProcess)
   Stack stack(*dir_ + "/global", 1, 512, /*index_shards=*/2);
   ASSERT_TRUE(stack.WaitServing());
   auto stub = stack.Coordinator();
-  ASSERT_TRUE(CreateCollection(stub.get(), "lfd", params).ok());
+  ASSERT_EQ(CreateCollection(stub.get(), "lfd", params), absl::OkStatus());
   std::set<std::string> jobs;
   ASSERT_EQ(Ingest(stub.get(), "lfd", 0, n, &jobs), n);
   for (const std::string& job : jobs) {
@@ -737,7 +669,7 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
   stack.index(0).Start();
   ASSERT_TRUE(stack.WaitServing());
   auto stub = stack.Coordinator();
-  ASSERT_TRUE(CreateCollection(stub.get(), "fused", params).ok());
+  ASSERT_EQ(CreateCollection(stub.get(), "fused", params), absl::OkStatus());
   {
     // idf needs document frequencies over the whole collection, which the
     // services do not keep: refused by name rather than served unweighted.
@@ -955,7 +887,7 @@ TEST_F(ServicesTest, TwoIndexShardsGiveTheResultsOfOneAndNeverAPartialAnswer) {
   Stack stack(*dir_ + "/shards", 1, 512, /*index_shards=*/2);
   ASSERT_TRUE(stack.WaitServing());
   auto stub = stack.Coordinator();
-  ASSERT_TRUE(CreateCollection(stub.get(), "synthetic").ok());
+  ASSERT_EQ(CreateCollection(stub.get(), "synthetic"), absl::OkStatus());
   const std::size_t n = models_->size();
   std::set<std::string> jobs;
   ASSERT_EQ(Ingest(stub.get(), "synthetic", 0, n, &jobs), n);
@@ -1018,8 +950,7 @@ TEST_F(ServicesTest, TwoIndexShardsGiveTheResultsOfOneAndNeverAPartialAnswer) {
   Server other("coordinator",
                {"--data_dir=" + *dir_ + "/shards/coordinator", "--resample=127.0.0.1:1",
                 "--extract=127.0.0.1:1", "--codebook=127.0.0.1:1",
-                "--index=" + Address(stack.index(0).port())},
-               rpc::FreeLoopbackPort());
+                "--index=" + Address(stack.index(0).port())});
   EXPECT_GT(other.WaitExit(absl::Seconds(20)), 0);
 }
 
@@ -1031,7 +962,7 @@ TEST_F(ServicesTest, AModelThatCannotBeExtractedEndsFailedAndTheBuildGoesOnWitho
               {"--model_attempts=2", "--call_attempts=2", "--retry_backoff=200ms"});
   ASSERT_TRUE(stack.WaitServing());
   auto stub = stack.Coordinator();
-  ASSERT_TRUE(CreateCollection(stub.get(), "failing").ok());
+  ASSERT_EQ(CreateCollection(stub.get(), "failing"), absl::OkStatus());
   std::set<std::string> jobs;
   ASSERT_EQ(Ingest(stub.get(), "failing", 0, 6, &jobs), 6u);
   EXPECT_EQ(WaitJob(stub.get(), *jobs.begin()).state(), v1::JOB_STATE_SUCCEEDED);
@@ -1099,12 +1030,12 @@ TEST_F(ServicesTest, ThumbnailsListingAndQueriesByModelServeTheWebPage) {
   auto stack = std::make_unique<Stack>(dir, 1);
   ASSERT_TRUE(stack->WaitServing());
   auto stub = stack->Coordinator();
-  ASSERT_TRUE(CreateCollection(stub.get(), "pictures").ok());
+  ASSERT_EQ(CreateCollection(stub.get(), "pictures"), absl::OkStatus());
   v1::PipelineParams fused;
   v1::ParamValue* method = fused.add_values();
   method->set_name("method");
   method->set_value("lsf+lfd");
-  ASSERT_TRUE(CreateCollection(stub.get(), "both", fused).ok());
+  ASSERT_EQ(CreateCollection(stub.get(), "both", fused), absl::OkStatus());
   std::set<std::string> jobs;
   ASSERT_EQ(Ingest(stub.get(), "pictures", 0, 8, &jobs), 8u);
 

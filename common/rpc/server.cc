@@ -187,6 +187,9 @@ absl::StatusOr<std::unique_ptr<RpcServer>> RpcServer::Start(
                         absl::StrCat(name, ": ", credentials.status().message()));
   }
   builder.AddListeningPort(options.address, *credentials, &server->port_);
+  // A port in use is refused: with gRPC's default SO_REUSEPORT a second
+  // server would bind it too and silently take some of the first's calls.
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.SetMaxReceiveMessageSize(options.max_message_bytes);
   builder.SetMaxSendMessageSize(options.max_message_bytes);
   grpc::ResourceQuota quota(absl::StrCat("meshseek-", name));
@@ -222,6 +225,7 @@ absl::StatusOr<std::unique_ptr<RpcServer>> RpcServer::Start(
     grpc::ServerBuilder health;
     health.AddListeningPort(options.health_address, grpc::InsecureServerCredentials(),
                             &server->health_port_);
+    health.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
     server->health_server_ = health.BuildAndStart();
     if (server->health_server_ == nullptr || server->health_port_ == 0) {
       return absl::UnavailableError(absl::StrCat(

@@ -1,6 +1,7 @@
 // RpcServer's admission: bursts beyond the server threads wait in the queue
 // and are served; only calls beyond the queue are refused, with
-// RESOURCE_EXHAUSTED; health checks answer while every slot is taken.
+// RESOURCE_EXHAUSTED; health checks answer while every slot is taken. A port
+// in use is refused.
 #include "common/rpc/server.h"
 
 #include <atomic>
@@ -125,6 +126,24 @@ TEST(ServerAdmissionTest, BeyondTheQueueCallsAreRefusedAndHealthStillAnswers) {
   EXPECT_GE(codes[grpc::StatusCode::RESOURCE_EXHAUSTED], 1);
   EXPECT_EQ(codes[grpc::StatusCode::OK] + codes[grpc::StatusCode::RESOURCE_EXHAUSTED], 24);
   EXPECT_LE(service.max_running(), 2);
+}
+
+// A second server on a port in use is refused, naming the address: with
+// gRPC's default SO_REUSEPORT both would listen, each answering some of
+// the calls meant for the other.
+TEST(ServerPortTest, APortInUseIsUnavailable) {
+  SlowIndex service(absl::Milliseconds(1));
+  ServerOptions options;
+  options.address = "127.0.0.1:0";
+  auto first = RpcServer::Start("first", {&service}, options);
+  ASSERT_TRUE(first.ok()) << first.status();
+  options.address = absl::StrCat("127.0.0.1:", (*first)->port());
+  SlowIndex other(absl::Milliseconds(1));
+  auto second = RpcServer::Start("second", {&other}, options);
+  ASSERT_FALSE(second.ok());
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_NE(second.status().message().find(options.address), std::string::npos)
+      << second.status();
 }
 
 }  // namespace
