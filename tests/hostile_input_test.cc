@@ -4,7 +4,6 @@
 // bad file must be refused with INVALID_ARGUMENT naming the file within a
 // second, every valid one accepted, and the server must still serve, with
 // resident memory under 1 GB, at the end.
-#include <signal.h>
 #include <unistd.h>
 
 #include <cstdint>
@@ -21,7 +20,6 @@
 #include "common/base/test_env.h"
 #include "common/rpc/client.h"
 #include "gmock/gmock.h"
-#include "grpc/health/v1/health.grpc.pb.h"
 #include "gtest/gtest.h"
 #include "tests/server_process.h"
 #include "meshseek/v1/coordinator.grpc.pb.h"

@@ -57,27 +57,30 @@ void ServerProcess::Kill(int signal) {
   pid_ = -1;
 }
 
-bool ServerProcess::ReadPort() {
+std::string ServerProcess::ReadLog(std::uintmax_t from) const {
   std::ifstream in(log_);
-  in.seekg(static_cast<std::streamoff>(log_start_));
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  in.seekg(static_cast<std::streamoff>(from));
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+void ServerProcess::ReadPort() {
+  const std::string text = ReadLog(log_start_);
   const std::size_t at = text.find(port_marker_);
-  if (at == std::string::npos) return false;
+  if (at == std::string::npos) return;
   const std::size_t begin = at + port_marker_.size();
   std::size_t end = begin;
   while (end < text.size() && text[end] >= '0' && text[end] <= '9') ++end;
+  // Nothing after the digits yet: the number may be cut short.
+  if (end == text.size()) return;
   int port = 0;
-  if (end == begin || end == text.size() || !absl::SimpleAtoi(text.substr(begin, end - begin), &port)) {
-    return false;  // not the whole number yet
-  }
-  port_ = port;
-  return true;
+  if (absl::SimpleAtoi(text.substr(begin, end - begin), &port)) port_ = port;
 }
 
-bool ServerProcess::Exited() {
+std::optional<int> ServerProcess::Reap() {
   int status = 0;
-  if (pid_ > 0 && waitpid(pid_, &status, WNOHANG) == pid_) pid_ = -1;
-  return pid_ <= 0;
+  if (pid_ <= 0 || waitpid(pid_, &status, WNOHANG) != pid_) return std::nullopt;
+  pid_ = -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
 }
 
 bool ServerProcess::WaitServing(absl::Duration within) {
@@ -85,7 +88,7 @@ bool ServerProcess::WaitServing(absl::Duration within) {
   // restart after kill -9 under TSan on a loaded machine takes seconds.
   const absl::Time end = absl::Now() + within;
   std::unique_ptr<grpc::health::v1::Health::Stub> health;
-  while (absl::Now() < end && !Exited()) {
+  while (absl::Now() < end && pid_ > 0 && !Reap().has_value()) {
     if (port_ == 0) ReadPort();
     if (port_ != 0 && health == nullptr) {
       health = grpc::health::v1::Health::NewStub(grpc::CreateChannel(
@@ -103,8 +106,7 @@ bool ServerProcess::WaitServing(absl::Duration within) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
-  std::ifstream in(log_);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = ReadLog(0);
   std::cerr << argv_[0] << (pid_ <= 0 ? " exited" : " is not serving") << "; the end of " << log_
             << ":\n"
             << text.substr(text.size() > 2000 ? text.size() - 2000 : 0) << "\n";
@@ -114,11 +116,7 @@ bool ServerProcess::WaitServing(absl::Duration within) {
 int ServerProcess::WaitExit(absl::Duration within) {
   const absl::Time end = absl::Now() + within;
   while (pid_ > 0 && absl::Now() < end) {
-    int status = 0;
-    if (waitpid(pid_, &status, WNOHANG) == pid_) {
-      pid_ = -1;
-      return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-    }
+    if (const std::optional<int> code = Reap()) return *code;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return -1;

@@ -22,6 +22,7 @@
 #include <sys/types.h>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,8 +62,9 @@ class ServerProcess {
   const std::string& log() const { return log_; }
 
  private:
-  bool ReadPort();   // from the log, past what earlier starts wrote
-  bool Exited();     // reaps it if so
+  std::string ReadLog(std::uintmax_t from) const;
+  void ReadPort();            // from the log, past what earlier starts wrote
+  std::optional<int> Reap();  // its exit code (128: a signal) if it has ended
 
   std::vector<std::string> argv_;
   std::string log_;
