@@ -13,6 +13,11 @@ int ResolveThreadCount(int requested) {
   return hw == 0 ? 1 : static_cast<int>(hw);
 }
 
+int CappedThreads(uint32_t asked, int num_threads) {
+  return static_cast<int>(
+      std::clamp<int64_t>(asked, 1, static_cast<int64_t>(ResolveThreadCount(num_threads))));
+}
+
 void ParallelFor(std::size_t n, int num_threads, const std::function<void(std::size_t)>& fn) {
   const std::size_t threads =
       std::min<std::size_t>(static_cast<std::size_t>(ResolveThreadCount(num_threads)), n);

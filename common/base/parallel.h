@@ -7,12 +7,17 @@
 #define MESHSEEK_COMMON_BASE_PARALLEL_H_
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 
 namespace meshseek {
 
 // Number of threads to use for a request of `requested` (<= 0 means "all cores").
 int ResolveThreadCount(int requested);
+
+// The threads one call that asks for `asked` may use on a server of
+// `num_threads` (<= 0: all cores): at least 1, at most the server's.
+int CappedThreads(uint32_t asked, int num_threads);
 
 // Calls fn(i) for every i in [0, n), on up to `num_threads` threads (<= 0: all
 // cores). Items are handed out one at a time from a shared counter, so uneven

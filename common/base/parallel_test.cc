@@ -25,5 +25,13 @@ TEST(ParallelForTest, ResolvesThreadCount) {
   EXPECT_GE(ResolveThreadCount(0), 1);
 }
 
+TEST(ParallelForTest, CapsWhatACallAsksForAtTheServers) {
+  EXPECT_EQ(CappedThreads(0, 4), 1);
+  EXPECT_EQ(CappedThreads(1, 4), 1);
+  EXPECT_EQ(CappedThreads(3, 4), 3);
+  EXPECT_EQ(CappedThreads(4000000000u, 4), 4);
+  EXPECT_EQ(CappedThreads(4000000000u, 0), ResolveThreadCount(0));
+}
+
 }  // namespace
 }  // namespace meshseek

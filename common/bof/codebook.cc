@@ -117,25 +117,28 @@ absl::StatusOr<Codebook> Codebook::FromCentroids(
 }
 
 absl::StatusOr<std::vector<uint32_t>> Codebook::NearestCentroids(const uint8_t* descriptors,
-                                                                 std::size_t count) const {
+                                                                 std::size_t count,
+                                                                 int num_threads) const {
   if (descriptors == nullptr && count > 0) {
     return absl::InvalidArgumentError(
         absl::StrCat("codebook: descriptors is null with count ", count));
   }
   std::vector<uint32_t> labels(count);
+  const int threads = std::max(num_threads, 1);
   if (tree_ != nullptr) {
-    tree_->Search(descriptors, count, /*num_threads=*/1, labels.data(), nullptr);
+    tree_->Search(descriptors, count, threads, labels.data(), nullptr);
   } else if (approximate_ != nullptr) {
-    approximate_->Search(descriptors, count, /*num_threads=*/1, labels.data(), nullptr);
+    approximate_->Search(descriptors, count, threads, labels.data(), nullptr);
   } else {
-    index_.Search(descriptors, count, /*num_threads=*/1, labels.data(), nullptr);
+    index_.Search(descriptors, count, threads, labels.data(), nullptr);
   }
   return labels;
 }
 
 absl::StatusOr<std::vector<float>> Codebook::Encode(const uint8_t* descriptors,
                                                     std::size_t count,
-                                                    std::size_t dimension) const {
+                                                    std::size_t dimension,
+                                                    int num_threads) const {
   if (count == 0) {
     return absl::InvalidArgumentError(
         "codebook: cannot encode an empty descriptor set (0 descriptors)");
@@ -145,7 +148,7 @@ absl::StatusOr<std::vector<float>> Codebook::Encode(const uint8_t* descriptors,
         "codebook: descriptors of dimension ", dimension, ", the codebook's words have ", dim_));
   }
   MESHSEEK_ASSIGN_OR_RETURN(const std::vector<uint32_t> labels,
-                            NearestCentroids(descriptors, count));
+                            NearestCentroids(descriptors, count, num_threads));
   std::vector<std::size_t> counts(size(), 0);
   for (uint32_t label : labels) ++counts[label];
   std::vector<float> histogram(size());

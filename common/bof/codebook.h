@@ -92,19 +92,24 @@ class Codebook {
   /// row-major; ties go to the lowest index), by the codebook's search (exact,
   /// or approximate: see above). Runs on the calling thread only:
   /// meshseek parallelises across models (parallel.h). InvalidArgument for null
-  /// descriptors with count > 0.
+  /// descriptors with count > 0. On up to `num_threads` threads (<= 1: the
+  /// calling thread), blocks of descriptors apart: the same words for any
+  /// count (a query's encoding asks for the cores, docs/design.md 1.1).
   absl::StatusOr<std::vector<uint32_t>> NearestCentroids(const uint8_t* descriptors,
-                                                         std::size_t count) const;
+                                                         std::size_t count,
+                                                         int num_threads = 1) const;
 
   /// The bag-of-features histogram of one model: for each word, the fraction
   /// of the `count` descriptors whose nearest word it is. Length size(), sums
   /// to 1 (up to float rounding). InvalidArgument when count is 0: a model
   /// without descriptors has no histogram, and a uniform or zero one would
   /// silently rank it among the others, and when `dimension` is not the
-  /// codebook's (features of another method).
+  /// codebook's (features of another method). `num_threads` as for
+  /// NearestCentroids.
   absl::StatusOr<std::vector<float>> Encode(const uint8_t* descriptors,
                                             std::size_t count,
-                                            std::size_t dimension) const;
+                                            std::size_t dimension,
+                                            int num_threads = 1) const;
 
   /// The serialised form described above.
   std::string Serialize() const;

@@ -106,6 +106,10 @@ TEST(CodebookTest, TrainLearnsTheRequestedVocabulary) {
   // Every word is used: k-means leaves no cluster empty on such data.
   const std::vector<float> histogram = codebook->Encode(descriptors.data(), 2000, kDim).value();
   for (float h : histogram) EXPECT_GT(h, 0.0f);
+  // Blocks of descriptors on several threads (a query's encoding): the same.
+  const std::vector<uint8_t> many = RandomDescriptors(9000, kDim, 7);
+  EXPECT_EQ(codebook->Encode(many.data(), 9000, kDim).value(),
+            codebook->Encode(many.data(), 9000, kDim, /*num_threads=*/3).value());
 
   options.num_centroids = 3000;
   EXPECT_THAT(

@@ -123,6 +123,82 @@ DistancePyramid BuildPyramid(const ViewImage& view, int max_levels) {
   return pyramid;
 }
 
+// The dense patches of one view after another (ExtractBfDsift), with the
+// scratch they share: one per thread.
+class ViewDescriber {
+ public:
+  ViewDescriber(const ViewRenderer& renderer, const BfDsiftOptions& options)
+      : renderer_(renderer), options_(options), describer_(options.descriptor) {
+    const int image = options.patch_image.image_size;
+    const double largest_radius =
+        options.patch_radius * options.view_size * (1 << (options.patch_scales - 1));
+    levels_ = 1 + std::max(0, static_cast<int>(std::floor(std::log2(2 * largest_radius / image))));
+    patch_.size = image;
+    patch_.depth.resize(static_cast<std::size_t>(image) * image);
+  }
+
+  // Appends the features of the view along `direction`.
+  void Describe(const Vec3d& direction, LocalFeatures* features);
+
+ private:
+  const ViewRenderer& renderer_;
+  const BfDsiftOptions& options_;
+  int levels_ = 1;
+  DepthSiftDescriber describer_;
+  PatchResampler resampler_;
+  DepthImage patch_;
+};
+
+void ViewDescriber::Describe(const Vec3d& direction, LocalFeatures* features) {
+  const Sphere& sphere = renderer_.sphere();
+  const int n = options_.view_size;
+  const int image = options_.patch_image.image_size;
+  const ViewCamera camera = CameraFor(direction);
+  const ViewImage view = renderer_.Render(camera);
+  const DistancePyramid pyramid = BuildPyramid(view, levels_);
+  std::size_t covered = 0;
+  for (const uint8_t m : view.mask) covered += m;
+  if (covered == 0) return;
+  // A grid step that puts about points_per_view points in the silhouette.
+  const double step =
+      std::max(1.0, std::sqrt(static_cast<double>(covered) / options_.points_per_view));
+  for (double gy = step / 2; gy < n; gy += step) {
+    for (double gx = step / 2; gx < n; gx += step) {
+      const int px = static_cast<int>(gx), py = static_cast<int>(gy);
+      if (!view.Covered(px, py)) continue;
+      const float centre = pyramid.levels[0][static_cast<std::size_t>(py) * n + px];
+      for (int s = 0; s < options_.patch_scales; ++s) {
+        const double radius = options_.patch_radius * n * (1 << s);  // level-0 pixels
+        // The pyramid level whose pixels are no larger than the patch's.
+        const double pixel = 2 * radius / image;
+        const int level =
+            std::clamp(static_cast<int>(std::floor(std::log2(std::max(pixel, 1.0)))),
+                       0,
+                       static_cast<int>(pyramid.levels.size()) - 1);
+        patch_.support_radius = static_cast<float>(radius);
+        resampler_.Resample(pyramid, level, px, py, radius, centre - radius, &patch_);
+        const int added = describer_.Describe(patch_, &features->descriptors);
+        // The surface point at the patch centre, back in model units.
+        const double a = (px + 0.5) / n * 2 - 1, b = 1 - (py + 0.5) / n * 2;
+        const double c = 1 - 2 * view.DepthAt(px, py);
+        const Vec3d q = sphere.center +
+                        (camera.right * a + camera.up * b + camera.direction * c) * sphere.radius;
+        Keypoint k;
+        k.position = Vec3f(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
+        k.view = Vec3f(static_cast<float>(camera.direction.x),
+                       static_cast<float>(camera.direction.y),
+                       static_cast<float>(camera.direction.z));
+        k.up = Vec3f(static_cast<float>(camera.up.x),
+                     static_cast<float>(camera.up.y),
+                     static_cast<float>(camera.up.z));
+        k.scale = static_cast<float>(radius / n * sphere.diameter());
+        k.level = s;
+        features->keypoints.insert(features->keypoints.end(), added, k);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 absl::Status BfDsiftOptions::Validate() const {
@@ -151,72 +227,18 @@ absl::Status BfDsiftOptions::Validate() const {
 }
 
 absl::StatusOr<LocalFeatures> ExtractBfDsift(const TriangleMesh& mesh,
-                                             const BfDsiftOptions& options) {
+                                             const BfDsiftOptions& options,
+                                             int num_threads) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   ViewRenderOptions render;
   render.image_size = options.view_size;
   MESHSEEK_ASSIGN_OR_RETURN(const ViewRenderer renderer, ViewRenderer::Create(mesh, render));
-  const Sphere& sphere = renderer.sphere();
-  const int n = options.view_size;
-  const int image = options.patch_image.image_size;
-  const double largest_radius = options.patch_radius * n * (1 << (options.patch_scales - 1));
-  const int levels =
-      1 + std::max(0, static_cast<int>(std::floor(std::log2(2 * largest_radius / image))));
-
-  LocalFeatures features;
-  DepthSiftDescriber describer(options.descriptor);
-  PatchResampler resampler;
-  DepthImage patch;
-  patch.size = image;
-  patch.depth.resize(static_cast<std::size_t>(image) * image);
-  for (const Vec3d& direction : IcosphereDirections(options.view_level)) {
-    const ViewCamera camera = CameraFor(direction);
-    const ViewImage view = renderer.Render(camera);
-    const DistancePyramid pyramid = BuildPyramid(view, levels);
-    std::size_t covered = 0;
-    for (const uint8_t m : view.mask) covered += m;
-    if (covered == 0) continue;
-    // A grid step that puts about points_per_view points in the silhouette.
-    const double step =
-        std::max(1.0, std::sqrt(static_cast<double>(covered) / options.points_per_view));
-    for (double gy = step / 2; gy < n; gy += step) {
-      for (double gx = step / 2; gx < n; gx += step) {
-        const int px = static_cast<int>(gx), py = static_cast<int>(gy);
-        if (!view.Covered(px, py)) continue;
-        const float centre = pyramid.levels[0][static_cast<std::size_t>(py) * n + px];
-        for (int s = 0; s < options.patch_scales; ++s) {
-          const double radius = options.patch_radius * n * (1 << s);  // level-0 pixels
-          // The pyramid level whose pixels are no larger than the patch's.
-          const double pixel = 2 * radius / image;
-          const int level =
-              std::clamp(static_cast<int>(std::floor(std::log2(std::max(pixel, 1.0)))),
-                         0,
-                         static_cast<int>(pyramid.levels.size()) - 1);
-          patch.support_radius = static_cast<float>(radius);
-          resampler.Resample(pyramid, level, px, py, radius, centre - radius, &patch);
-          const int added = describer.Describe(patch, &features.descriptors);
-          // The surface point at the patch centre, back in model units.
-          const double a = (px + 0.5) / n * 2 - 1, b = 1 - (py + 0.5) / n * 2;
-          const double c = 1 - 2 * view.DepthAt(px, py);
-          const Vec3d q = sphere.center +
-                          (camera.right * a + camera.up * b + camera.direction * c) * sphere.radius;
-          Keypoint k;
-          k.position =
-              Vec3f(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
-          k.view = Vec3f(static_cast<float>(camera.direction.x),
-                         static_cast<float>(camera.direction.y),
-                         static_cast<float>(camera.direction.z));
-          k.up = Vec3f(static_cast<float>(camera.up.x),
-                       static_cast<float>(camera.up.y),
-                       static_cast<float>(camera.up.z));
-          k.scale = static_cast<float>(radius / n * sphere.diameter());
-          k.level = s;
-          features.keypoints.insert(features.keypoints.end(), added, k);
-        }
-      }
-    }
-  }
-  return features;
+  const std::vector<Vec3d> directions = IcosphereDirections(options.view_level);
+  return DescribeInRuns(directions.size(), num_threads, [&](std::size_t begin, std::size_t end,
+                                                            LocalFeatures* out) {
+    ViewDescriber describer(renderer, options);
+    for (std::size_t v = begin; v < end; ++v) describer.Describe(directions[v], out);
+  });
 }
 
 }  // namespace meshseek

@@ -76,9 +76,11 @@ struct BfDsiftOptions {
 /// The dense SIFT features of every view of `mesh`. Keypoints: position = the
 /// surface point seen at the patch centre, view = the view direction, up = the
 /// view's up axis, scale = the patch radius in model units. InvalidArgument
-/// for a mesh without area or extent.
+/// for a mesh without area or extent. num_threads > 1 describes the views on
+/// that many threads: the same features, in the same order.
 absl::StatusOr<LocalFeatures> ExtractBfDsift(const TriangleMesh& mesh,
-                                             const BfDsiftOptions& options);
+                                             const BfDsiftOptions& options,
+                                             int num_threads = 1);
 
 }  // namespace meshseek
 

@@ -106,6 +106,20 @@ TEST(BfDsiftTest, SoupsAndSeveralComponentsWorkAndRunsAreDeterministic) {
   EXPECT_EQ(m->descriptors, a->descriptors);
 }
 
+// Views described on several threads (a query's extraction) give the same
+// features in the same order.
+TEST(BfDsiftTest, ThreadsChangeNothing) {
+  const auto one = ExtractBfDsift(Torus(), Small());
+  const auto three = ExtractBfDsift(Torus(), Small(), /*num_threads=*/3);
+  ASSERT_TRUE(one.ok() && three.ok());
+  EXPECT_EQ(one->descriptors, three->descriptors);
+  ASSERT_EQ(one->size(), three->size());
+  for (std::size_t i = 0; i < one->size(); ++i) {
+    EXPECT_EQ(one->keypoints[i].position, three->keypoints[i].position) << i;
+    EXPECT_EQ(one->keypoints[i].level, three->keypoints[i].level) << i;
+  }
+}
+
 TEST(BfDsiftTest, RejectsMeshesWithoutExtent) {
   TriangleMesh point;
   point.vertices = {Vec3f(1, 1, 1), Vec3f(1, 1, 1), Vec3f(1, 1, 1)};

@@ -41,7 +41,8 @@ absl::Status DldSiftOptions::Validate() const {
 }
 
 absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh,
-                                             const DldSiftOptions& options) {
+                                             const DldSiftOptions& options,
+                                             int num_threads) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));
   MESHSEEK_ASSIGN_OR_RETURN(const Sphere sphere, MinimumEnclosingSphere(mesh));
@@ -58,19 +59,16 @@ absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh,
   MESHSEEK_ASSIGN_OR_RETURN(const SurfacePoints dense, SampleSurface(mesh, frame_count));
   const double frame_radius = options.frame_radius_factor * s;
   const PointGrid grid(dense.positions, static_cast<float>(frame_radius));
-  LocalDepthSift describer(mesh, options.depth_image, options.descriptor);
-
-  LocalFeatures features;
-  features.keypoints.reserve(2 * centres.size());
-  features.descriptors.reserve(2 * centres.size() * kSiftDimension);
-  std::vector<uint32_t> support;
-  for (const Vec3f& p : centres.positions) {
-    const auto axes =
-        SupportAxes(dense.positions, grid, p, frame_radius, options.weighted_frame, &support);
-    if (!axes) continue;
-    describer.Describe(
-        {Vec3d(p), axes->axes[0], axes->axes[2], s}, options.two_views, 0, &features);
-  }
+  LocalFeatures features = DescribeFrames(
+      mesh, centres.size(), options.two_views, options.depth_image, options.descriptor,
+      num_threads,
+      [&](std::size_t i, std::vector<uint32_t>* support) -> std::optional<LevelFrame> {
+        const Vec3f& p = centres.positions[i];
+        const auto axes =
+            SupportAxes(dense.positions, grid, p, frame_radius, options.weighted_frame, support);
+        if (!axes) return std::nullopt;
+        return LevelFrame{{Vec3d(p), axes->axes[0], axes->axes[2], s}, 0};
+      });
   if (features.keypoints.empty()) {
     return absl::InvalidArgumentError("DLD-SIFT found no usable feature point on the model");
   }

@@ -64,9 +64,11 @@ struct DldSiftOptions {
 };
 
 // Extracts DLD-SIFT features. The mesh must be valid (ValidateMesh), which is
-// checked. Errors name the problem (e.g. a degenerate model).
+// checked. Errors name the problem (e.g. a degenerate model). num_threads > 1
+// describes the frames on that many threads (DescribeFrames): the same features.
 absl::StatusOr<LocalFeatures> ExtractDldSift(const TriangleMesh& mesh,
-                                             const DldSiftOptions& options);
+                                             const DldSiftOptions& options,
+                                             int num_threads = 1);
 
 }  // namespace meshseek
 

@@ -68,6 +68,10 @@ TEST(DldSiftTest, IsDeterministicAndIgnoresTessellationSharing) {
   EXPECT_EQ(a->descriptors, b->descriptors);
   // The same triangles as a polygon soup: the dense method does not care.
   EXPECT_EQ(a->descriptors, soup->descriptors);
+  // Points described on several threads (a query's extraction): the same.
+  auto threaded = ExtractDldSift(mesh, options, /*num_threads=*/3);
+  ASSERT_TRUE(threaded.ok());
+  EXPECT_EQ(a->descriptors, threaded->descriptors);
 }
 
 // Descriptors of one feature point, grouped by its position (features come

@@ -15,7 +15,8 @@ absl::Status LdSiftOptions::Validate() const {
 
 absl::StatusOr<LocalFeatures> ExtractLdSift(const TriangleMesh& mesh,
                                             const LdSiftOptions& options,
-                                            std::vector<InterestPoint>* detected) {
+                                            std::vector<InterestPoint>* detected,
+                                            int num_threads) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));
   const MeshVertexGraph vertex_graph = BuildMeshVertexGraph(mesh);
@@ -32,7 +33,8 @@ absl::StatusOr<LocalFeatures> ExtractLdSift(const TriangleMesh& mesh,
         Vec3d up = axes.axes[0] - normal * Dot(axes.axes[0], normal);
         if (SquaredNorm(up) < 1e-12) up = axes.axes[1] - normal * Dot(axes.axes[1], normal);
         return ViewFrame{Vec3d(p), Normalized(up), normal, ip.scale};
-      });
+      },
+      num_threads);
   if (detected != nullptr) *detected = std::move(points);
   return features;
 }

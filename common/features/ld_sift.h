@@ -51,10 +51,12 @@ struct LdSiftOptions {
 // points (vertex indices refer to the OpenMesh vertex graph, whose positions
 // are in each keypoint). A model on which nothing is detected gives an empty
 // set, not an error: that is LD-SIFT's documented weakness on sparse meshes
-// and soups.
+// and soups. num_threads > 1 describes the points on that many threads
+// (DescribeFrames): the same features.
 absl::StatusOr<LocalFeatures> ExtractLdSift(const TriangleMesh& mesh,
                                             const LdSiftOptions& options,
-                                            std::vector<InterestPoint>* detected = nullptr);
+                                            std::vector<InterestPoint>* detected = nullptr,
+                                            int num_threads = 1);
 
 }  // namespace meshseek
 

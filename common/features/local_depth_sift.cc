@@ -18,9 +18,10 @@ std::optional<PrincipalAxes> SupportAxes(const std::vector<Vec3f>& points,
 }
 
 LocalDepthSift::LocalDepthSift(const TriangleMesh& mesh,
+                               const TriangleBvh& bvh,
                                const DepthImageOptions& image_options,
                                const SiftDescriptorOptions& descriptor_options)
-    : bvh_(mesh), renderer_(mesh, bvh_, image_options), describer_(descriptor_options) {}
+    : renderer_(mesh, bvh, image_options), describer_(descriptor_options) {}
 
 void LocalDepthSift::Describe(const ViewFrame& frame,
                               bool two_views,
@@ -39,6 +40,26 @@ void LocalDepthSift::Describe(const ViewFrame& frame,
   }
 }
 
+LocalFeatures DescribeFrames(const TriangleMesh& mesh,
+                             std::size_t count,
+                             bool two_views,
+                             const DepthImageOptions& image_options,
+                             const SiftDescriptorOptions& descriptor_options,
+                             int num_threads,
+                             const FrameOf& frame_of) {
+  const TriangleBvh bvh(mesh);
+  return DescribeInRuns(count, num_threads, [&](std::size_t begin, std::size_t end,
+                                                LocalFeatures* out) {
+    LocalDepthSift describer(mesh, bvh, image_options, descriptor_options);
+    std::vector<uint32_t> support;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (const std::optional<LevelFrame> f = frame_of(i, &support)) {
+        describer.Describe(f->frame, two_views, f->level, out);
+      }
+    }
+  });
+}
+
 LocalFeatures DescribeInterestPoints(const TriangleMesh& mesh,
                                      const std::vector<Vec3f>& positions,
                                      const std::vector<InterestPoint>& points,
@@ -46,20 +67,21 @@ LocalFeatures DescribeInterestPoints(const TriangleMesh& mesh,
                                      bool two_views,
                                      const DepthImageOptions& image_options,
                                      const SiftDescriptorOptions& descriptor_options,
-                                     const InterestPointFrame& make_frame) {
-  LocalFeatures features;
-  if (points.empty()) return features;
+                                     const InterestPointFrame& make_frame,
+                                     int num_threads) {
+  if (points.empty()) return LocalFeatures();
   const PointGrid grid(positions, std::max(MedianScale(points), 1e-12f));
-  LocalDepthSift describer(mesh, image_options, descriptor_options);
-  std::vector<uint32_t> support;
-  for (const InterestPoint& ip : points) {
-    const Vec3f& p = positions[ip.vertex];
-    const auto axes = SupportAxes(positions, grid, p, ip.scale, weighted, &support);
-    if (!axes) continue;
-    const std::optional<ViewFrame> frame = make_frame(ip, p, *axes);
-    if (frame) describer.Describe(*frame, two_views, ip.level, &features);
-  }
-  return features;
+  return DescribeFrames(
+      mesh, points.size(), two_views, image_options, descriptor_options, num_threads,
+      [&](std::size_t i, std::vector<uint32_t>* support) -> std::optional<LevelFrame> {
+        const InterestPoint& ip = points[i];
+        const Vec3f& p = positions[ip.vertex];
+        const auto axes = SupportAxes(positions, grid, p, ip.scale, weighted, support);
+        if (!axes) return std::nullopt;
+        const std::optional<ViewFrame> frame = make_frame(ip, p, *axes);
+        if (!frame) return std::nullopt;
+        return LevelFrame{*frame, ip.level};
+      });
 }
 
 }  // namespace meshseek

@@ -32,11 +32,12 @@ std::optional<PrincipalAxes> SupportAxes(const std::vector<Vec3f>& points,
                                          bool weighted,
                                          std::vector<uint32_t>* scratch);
 
-// Renders and describes local depth images of one mesh. Holds the mesh's BVH
-// and scratch buffers: one per thread and model; the mesh must outlive it.
+// Renders and describes local depth images of one mesh. Holds scratch
+// buffers: one per thread; the mesh and its BVH must outlive it.
 class LocalDepthSift {
  public:
   LocalDepthSift(const TriangleMesh& mesh,
+                 const TriangleBvh& bvh,
                  const DepthImageOptions& image_options,
                  const SiftDescriptorOptions& descriptor_options);
 
@@ -47,11 +48,33 @@ class LocalDepthSift {
   void Describe(const ViewFrame& frame, bool two_views, int level, LocalFeatures* out);
 
  private:
-  TriangleBvh bvh_;
   DepthImageRenderer renderer_;
   DepthSiftDescriber describer_;
   DepthImage front_, back_;
 };
+
+// One frame to describe and the scale-space level its keypoints record.
+struct LevelFrame {
+  ViewFrame frame;
+  int level = 0;
+};
+
+// The frame of item i, nullopt to skip it; `support` is the calling thread's
+// scratch for SupportAxes. Called concurrently for different items.
+using FrameOf =
+    std::function<std::optional<LevelFrame>(std::size_t i, std::vector<uint32_t>* support)>;
+
+// The features of items 0 .. count - 1 (FrameOf, LocalDepthSift::Describe),
+// in item order, on up to `num_threads` threads (DescribeInRuns: the same
+// features for every count), each run of items with its own renderer and
+// describer and the mesh's BVH built once and shared.
+LocalFeatures DescribeFrames(const TriangleMesh& mesh,
+                             std::size_t count,
+                             bool two_views,
+                             const DepthImageOptions& image_options,
+                             const SiftDescriptorOptions& descriptor_options,
+                             int num_threads,
+                             const FrameOf& frame_of);
 
 // The view frame of a detected point, made from the point and the PCA axes of
 // its support; nullopt skips the point.
@@ -63,6 +86,7 @@ using InterestPointFrame = std::function<std::optional<ViewFrame>(
 // `positions` within each point's scale (SupportAxes, `weighted`), the frame
 // `make_frame` makes of them, and LocalDepthSift's views of `mesh`. The two
 // methods differ only in `make_frame`, `weighted` and `two_views`.
+// `make_frame` is called concurrently with num_threads > 1 (DescribeFrames).
 LocalFeatures DescribeInterestPoints(const TriangleMesh& mesh,
                                      const std::vector<Vec3f>& positions,
                                      const std::vector<InterestPoint>& points,
@@ -70,7 +94,8 @@ LocalFeatures DescribeInterestPoints(const TriangleMesh& mesh,
                                      bool two_views,
                                      const DepthImageOptions& image_options,
                                      const SiftDescriptorOptions& descriptor_options,
-                                     const InterestPointFrame& make_frame);
+                                     const InterestPointFrame& make_frame,
+                                     int num_threads = 1);
 
 }  // namespace meshseek
 

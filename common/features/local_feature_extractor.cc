@@ -11,26 +11,29 @@ namespace {
 absl::StatusOr<LocalFeatures> ExtractDld(const TriangleMesh& mesh,
                                          const ExtractorOptions& options,
                                          const PointGraph*) {
-  return ExtractDldSift(mesh, options.dld);
+  return ExtractDldSift(mesh, options.dld, options.num_threads);
 }
 
 absl::StatusOr<LocalFeatures> ExtractLd(const TriangleMesh& mesh,
                                         const ExtractorOptions& options,
                                         const PointGraph*) {
-  return ExtractLdSift(mesh, options.ld);
+  return ExtractLdSift(mesh, options.ld, /*detected=*/nullptr, options.num_threads);
 }
 
 absl::StatusOr<LocalFeatures> ExtractRld(const TriangleMesh& mesh,
                                          const ExtractorOptions& options,
                                          const PointGraph* resampled) {
-  if (resampled != nullptr) return DescribeRldSift(mesh, *resampled, options.rld);
-  return ExtractRldSift(mesh, options.rld);
+  if (resampled != nullptr) {
+    return DescribeRldSift(mesh, *resampled, options.rld, /*detected=*/nullptr, options.num_threads);
+  }
+  return ExtractRldSift(mesh, options.rld, /*resampled=*/nullptr, /*detected=*/nullptr,
+                        options.num_threads);
 }
 
 absl::StatusOr<LocalFeatures> ExtractBf(const TriangleMesh& mesh,
                                         const ExtractorOptions& options,
                                         const PointGraph*) {
-  return ExtractBfDsift(mesh, options.bfdsift);
+  return ExtractBfDsift(mesh, options.bfdsift, options.num_threads);
 }
 
 absl::StatusOr<LocalFeatures> ExtractLocalStatistics(const TriangleMesh& mesh,

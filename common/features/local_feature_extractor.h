@@ -118,13 +118,20 @@ struct ExtractorOptions {
   BfDsiftOptions bfdsift;
   LsfOptions lsf;
   LfdOptions lfd;
+  /// Not a parameter of the collection but of one call: the threads one
+  /// model's extraction may use (<= 1: the calling thread). The features do
+  /// not depend on it. DLD-, LD- and RLD-SIFT describe their points and
+  /// BF-DSIFT its views in runs on that many threads (DescribeInRuns); LSF
+  /// and LFD use one. Models extracted side by side (ingest, eval) keep 1; a
+  /// query's extraction asks for the cores (docs/design.md 1.1).
+  int num_threads = 1;
 
   /// Validates the options of the selected method.
   absl::Status Validate() const;
 };
 
 // Extracts the local features of one mesh with the selected method, on the
-// calling thread. LD-SIFT and RLD-SIFT may return an empty set (nothing
+// calling thread (and options.num_threads - 1 more where it says). LD-SIFT and RLD-SIFT may return an empty set (nothing
 // detected); DLD-SIFT always describes its points. For RLD-SIFT, `resampled`
 // may carry the graph ResampleSurfaceGraph made for this mesh with the
 // options' num_samples and neighbors (the resample service's output); the

@@ -7,7 +7,9 @@
 #ifndef MESHSEEK_COMMON_FEATURES_LOCAL_FEATURES_H_
 #define MESHSEEK_COMMON_FEATURES_LOCAL_FEATURES_H_
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -37,6 +39,25 @@ struct LocalFeatures {
   std::size_t size() const { return keypoints.size(); }
   const uint8_t* descriptor(std::size_t i) const { return descriptors.data() + i * dimension; }
 };
+
+/// Appends the features of `from` to `to` (the same dimension).
+inline void AppendFeatures(const LocalFeatures& from, LocalFeatures* to) {
+  to->keypoints.insert(to->keypoints.end(), from.keypoints.begin(), from.keypoints.end());
+  to->descriptors.insert(to->descriptors.end(), from.descriptors.begin(), from.descriptors.end());
+}
+
+/// The features of items 0 .. n - 1 as `describe(begin, end, out)` appends
+/// those of the items [begin, end) to `out`, in item order, on up to
+/// `num_threads` threads (<= 1: one run on the calling thread): contiguous
+/// runs, about four a thread so that unequal items even out, each into its
+/// own set, concatenated. The same features for every thread count when
+/// `describe` depends on nothing but its items. Several threads on one
+/// model are for a query's latency (docs/design.md 1.1); models side by
+/// side keep one core each.
+LocalFeatures DescribeInRuns(
+    std::size_t n,
+    int num_threads,
+    const std::function<void(std::size_t begin, std::size_t end, LocalFeatures* out)>& describe);
 
 /// A global method's output in the same form: one feature whose descriptor is
 /// the model's whole fixed-size descriptor (its keypoint is all zeros), so

@@ -36,7 +36,8 @@ absl::StatusOr<PointGraph> ResampleSurfaceGraph(const TriangleMesh& mesh,
 absl::StatusOr<LocalFeatures> DescribeRldSift(const TriangleMesh& mesh,
                                               const PointGraph& graph,
                                               const RldSiftOptions& options,
-                                              std::vector<InterestPoint>* detected) {
+                                              std::vector<InterestPoint>* detected,
+                                              int num_threads) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   MESHSEEK_RETURN_IF_ERROR(ValidateMesh(mesh));
   MESHSEEK_RETURN_IF_ERROR(ValidatePointGraph(graph));
@@ -46,7 +47,8 @@ absl::StatusOr<LocalFeatures> DescribeRldSift(const TriangleMesh& mesh,
       options.depth_image, options.descriptor,
       [](const InterestPoint& ip, const Vec3f& p, const PrincipalAxes& axes) {
         return std::optional<ViewFrame>(ViewFrame{Vec3d(p), axes.axes[0], axes.axes[2], ip.scale});
-      });
+      },
+      num_threads);
   if (detected != nullptr) *detected = std::move(points);
   return features;
 }
@@ -54,12 +56,13 @@ absl::StatusOr<LocalFeatures> DescribeRldSift(const TriangleMesh& mesh,
 absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh,
                                              const RldSiftOptions& options,
                                              SurfacePoints* resampled,
-                                             std::vector<InterestPoint>* detected) {
+                                             std::vector<InterestPoint>* detected,
+                                             int num_threads) {
   MESHSEEK_RETURN_IF_ERROR(options.Validate());
   MESHSEEK_ASSIGN_OR_RETURN(
       const PointGraph graph,
       ResampleSurfaceGraph(mesh, options.num_samples, options.neighbors, resampled));
-  return DescribeRldSift(mesh, graph, options, detected);
+  return DescribeRldSift(mesh, graph, options, detected, num_threads);
 }
 
 }  // namespace meshseek

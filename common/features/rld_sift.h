@@ -59,11 +59,13 @@ absl::StatusOr<PointGraph> ResampleSurfaceGraph(const TriangleMesh& mesh,
 // ResampleSurfaceGraph made it with options.num_samples and
 // options.neighbors) and two depth images of `mesh` per interest point. The
 // graph is checked (ValidatePointGraph); options.num_samples and neighbors
-// are not used.
+// are not used. num_threads > 1 describes the points on that many threads
+// (DescribeFrames): the same features.
 absl::StatusOr<LocalFeatures> DescribeRldSift(const TriangleMesh& mesh,
                                               const PointGraph& graph,
                                               const RldSiftOptions& options,
-                                              std::vector<InterestPoint>* detected = nullptr);
+                                              std::vector<InterestPoint>* detected = nullptr,
+                                              int num_threads = 1);
 
 // Extracts RLD-SIFT features: both steps. `resampled` and `detected`, if given, receive
 // the resample points and the interest points (vertex = resample index). A
@@ -71,7 +73,8 @@ absl::StatusOr<LocalFeatures> DescribeRldSift(const TriangleMesh& mesh,
 absl::StatusOr<LocalFeatures> ExtractRldSift(const TriangleMesh& mesh,
                                              const RldSiftOptions& options,
                                              SurfacePoints* resampled = nullptr,
-                                             std::vector<InterestPoint>* detected = nullptr);
+                                             std::vector<InterestPoint>* detected = nullptr,
+                                             int num_threads = 1);
 
 }  // namespace meshseek
 

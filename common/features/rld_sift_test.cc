@@ -104,6 +104,28 @@ TEST(ScaleSpaceMethodsTest, RldSiftInTwoStepsEqualsOneStep) {
             absl::StatusCode::kInvalidArgument);
 }
 
+// Points described on several threads (a query's extraction) give the same
+// features in the same order, for both methods.
+TEST(ScaleSpaceMethodsTest, ThreadsChangeNothing) {
+  const TriangleMesh mesh = BumpyShape(4);
+  RldSiftOptions options;
+  options.num_samples = 3000;
+  const auto one = ExtractRldSift(mesh, options);
+  const auto three = ExtractRldSift(mesh, options, nullptr, nullptr, /*num_threads=*/3);
+  const auto ld_one = ExtractLdSift(mesh, LdSiftOptions());
+  const auto ld_three = ExtractLdSift(mesh, LdSiftOptions(), nullptr, /*num_threads=*/3);
+  ASSERT_TRUE(one.ok() && three.ok() && ld_one.ok() && ld_three.ok());
+  EXPECT_GT(one->size(), 12u);
+  EXPECT_EQ(one->descriptors, three->descriptors);
+  EXPECT_GT(ld_one->size(), 12u);
+  EXPECT_EQ(ld_one->descriptors, ld_three->descriptors);
+  ASSERT_EQ(one->size(), three->size());
+  for (std::size_t i = 0; i < one->size(); ++i) {
+    EXPECT_EQ(one->keypoints[i].position, three->keypoints[i].position) << i;
+    EXPECT_EQ(one->keypoints[i].level, three->keypoints[i].level) << i;
+  }
+}
+
 // Rigid motion and uniform scale: every stage of both methods is
 // similarity-covariant, so the interest points map onto each other and their
 // descriptors nearly agree. Tolerance as for DLD-SIFT: the mean distance from

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "absl/strings/str_cat.h"
+#include "common/base/parallel.h"
 #include "common/base/status_macros.h"
 #include "common/features/sift_descriptor.h"
 #include "common/wire/convert.h"
@@ -129,7 +130,8 @@ absl::StatusOr<v1::EncodeResponse> CodebookService::Encode(const v1::EncodeReque
   if (features.size() > 0) {
     MESHSEEK_ASSIGN_OR_RETURN(
         histogram,
-        entry.codebook->Encode(features.descriptors.data(), features.size(), features.dimension));
+        entry.codebook->Encode(features.descriptors.data(), features.size(), features.dimension,
+                               CappedThreads(request.threads(), options_.num_threads)));
   }
   v1::EncodeResponse response;
   wire::HistogramToProto(histogram, entry.codebook->size(), response.mutable_histogram());

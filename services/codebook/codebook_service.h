@@ -25,7 +25,8 @@ namespace meshseek {
 struct CodebookServiceOptions {
   /// Folder of the database (codebook.db); created if missing.
   std::string data_dir;
-  /// Threads for k-means and encoding (<= 0: all cores). Results do not
+  /// Threads for k-means (<= 0: all cores), and the most one encoding may
+  /// use when it asks for several (EncodeRequest.threads). Results do not
   /// depend on it.
   int num_threads = 0;
 

@@ -103,12 +103,16 @@ absl::StatusOr<std::vector<IndexSignature>> CoordinatorService::QuerySignatures(
   std::vector<absl::StatusOr<IndexSignature>> encoded(parts, absl::UnknownError(""));
   std::vector<uint32_t> counts(parts, 0);
   std::vector<v1::MethodTiming> times(parts);
+  // The parts run side by side, each asking for every core (the services
+  // cap it at theirs): the first to finish leaves its cores to the last,
+  // which otherwise would run alone on one (docs/design.md 1.1).
+  const auto threads = static_cast<uint32_t>(ResolveThreadCount(0));
   const absl::Time start = absl::Now();
   ParallelFor(parts, static_cast<int>(parts), [&](std::size_t p) {
     const CollectionInfo& part = plan.parts[p];
     times[p].set_method(FeatureMethodName(part.options.extractor.method));
     const absl::Time extract_start = absl::Now();
-    absl::StatusOr<v1::LocalFeatures> extracted = workers_.Extract(mesh, part, "query");
+    absl::StatusOr<v1::LocalFeatures> extracted = workers_.Extract(mesh, part, "query", threads);
     const absl::Time encode_start = absl::Now();
     times[p].set_extract_seconds(absl::ToDoubleSeconds(encode_start - extract_start));
     if (!extracted.ok()) {
@@ -116,7 +120,7 @@ absl::StatusOr<std::vector<IndexSignature>> CoordinatorService::QuerySignatures(
       return;
     }
     counts[p] = extracted->count();
-    encoded[p] = workers_.Encode(part, part.codebook_id, *extracted);
+    encoded[p] = workers_.Encode(part, part.codebook_id, *extracted, threads);
     times[p].set_encode_seconds(absl::ToDoubleSeconds(absl::Now() - encode_start));
   });
   timings->set_signatures_seconds(absl::ToDoubleSeconds(absl::Now() - start));

@@ -98,11 +98,13 @@ Workers::Workers(const CoordinatorOptions& options, const std::atomic<bool>* sto
 
 absl::StatusOr<v1::LocalFeatures> Workers::Extract(const v1::Mesh& mesh,
                                                    const CollectionInfo& collection,
-                                                   const std::string& model_id) {
+                                                   const std::string& model_id,
+                                                   uint32_t threads) {
   v1::ExtractRequest request;
   *request.mutable_mesh()->mutable_mesh() = mesh;
   *request.mutable_params() = collection.params;
   request.set_model_id(model_id);
+  request.set_threads(threads);
   if (collection.options.extractor.method == FeatureMethod::kRldSift) {
     v1::ResampleRequest resample;
     *resample.mutable_mesh()->mutable_mesh() = mesh;
@@ -122,7 +124,8 @@ absl::StatusOr<v1::LocalFeatures> Workers::Extract(const v1::Mesh& mesh,
 
 absl::StatusOr<IndexSignature> Workers::Encode(const CollectionInfo& collection,
                                                const std::string& codebook_id,
-                                               const v1::LocalFeatures& features) {
+                                               const v1::LocalFeatures& features,
+                                               uint32_t threads) {
   IndexSignature signature;
   const FeatureMethod method = collection.options.extractor.method;
   if (FeatureMethodInfoOf(method).kind == DescriptorKind::kGlobal) {
@@ -142,6 +145,7 @@ absl::StatusOr<IndexSignature> Workers::Encode(const CollectionInfo& collection,
   }
   v1::EncodeRequest request;
   request.set_codebook_id(codebook_id);
+  request.set_threads(threads);
   *request.mutable_features() = features;
   v1::EncodeResponse response;
   MESHSEEK_RETURN_IF_ERROR(rpc::CallWithRetry(codebook_.get(), &v1::Codebook::Stub::Encode, request,

@@ -82,15 +82,19 @@ class Workers {
 
   const CoordinatorOptions& options() const { return options_; }
 
-  /// Resamples (RLD-SIFT) and extracts one mesh.
+  /// Resamples (RLD-SIFT) and extracts one mesh, on up to `threads` of the
+  /// extract service's cores (ExtractRequest.threads; 0: one).
   absl::StatusOr<v1::LocalFeatures> Extract(const v1::Mesh& mesh,
                                             const CollectionInfo& collection,
-                                            const std::string& model_id);
+                                            const std::string& model_id,
+                                            uint32_t threads = 0);
   /// The signature of extracted features: encoded with `codebook_id` by the
-  /// codebook service, or, for a global method, the features' one descriptor.
+  /// codebook service (on up to `threads` of its cores, as Extract), or, for
+  /// a global method, the features' one descriptor.
   absl::StatusOr<IndexSignature> Encode(const CollectionInfo& collection,
                                         const std::string& codebook_id,
-                                        const v1::LocalFeatures& features);
+                                        const v1::LocalFeatures& features,
+                                        uint32_t threads = 0);
   absl::Status AddToIndex(const std::string& collection,
                           const std::string& model_id,
                           uint64_t ordinal,

@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "common/base/parallel.h"
 #include "common/base/status_macros.h"
 #include "common/features/local_feature_extractor.h"
 #include "common/wire/convert.h"
@@ -37,6 +38,7 @@ absl::StatusOr<v1::ExtractResponse> ExtractService::Extract(const v1::ExtractReq
   if (!options.ok()) return fail(options.status());
   absl::StatusOr<TriangleMesh> mesh = wire::MeshFromProto(request.mesh(), mesh_limits_);
   if (!mesh.ok()) return fail(mesh.status());
+  options->extractor.num_threads = CappedThreads(request.threads(), workers_);
   std::optional<PointGraph> graph;
   if (request.has_resampled() && options->extractor.method == FeatureMethod::kRldSift) {
     absl::StatusOr<PointGraph> parsed = wire::GraphFromProto(request.resampled());

@@ -2,9 +2,11 @@
 // features by the requested method (ExtractLocalFeatures). Stateless; the hot
 // path, scaled by replicas.
 //
-// At most `workers` extractions run at once (each is single-threaded and
-// CPU-bound); further calls wait for a slot, and a call whose deadline passes
-// while waiting fails DEADLINE_EXCEEDED without having started.
+// At most `workers` extractions run at once (each is CPU-bound and on one
+// thread unless it asks for more: ExtractRequest.threads, at most `workers`,
+// what a query does so that a fused collection's methods finish together);
+// further calls wait for a slot, and a call whose deadline passes while
+// waiting fails DEADLINE_EXCEEDED without having started.
 #ifndef MESHSEEK_SERVICES_EXTRACT_EXTRACT_SERVICE_H_
 #define MESHSEEK_SERVICES_EXTRACT_EXTRACT_SERVICE_H_
 
