@@ -362,6 +362,11 @@ void VocabularyTree::SearchBlock(const uint8_t* points,
   std::vector<float> batch, local_score;
   for (int pass = 0; pass < depth_; ++pass) {
     next.Clear();
+    // Only the best of the last level is kept (labels and distances read
+    // entry 0 of each beam), and the beams' order is total (score, then
+    // node): each node's own best alone gives the same winner, with a
+    // fraction of the top-k insertions, which cost more than the distances.
+    const bool last = pass + 1 == depth_;
     // Leaves stay in the beam; internal nodes are bucketed (counting sort)
     // so that each searches its points' block at once.
     std::fill(offsets.begin(), offsets.end(), 0u);
@@ -387,7 +392,7 @@ void VocabularyTree::SearchBlock(const uint8_t* points,
       const std::size_t m = offsets[id + 1] - offsets[id];
       if (m == 0) continue;
       const Node& at = nodes_[id];
-      const std::size_t k = std::min<std::size_t>(beam, at.num_children);
+      const std::size_t k = last ? 1 : std::min<std::size_t>(beam, at.num_children);
       batch.resize(m * dim);
       for (std::size_t j = 0; j < m; ++j) {
         std::copy_n(&x[bucket[offsets[id] + j] * dim], dim, &batch[j * dim]);
