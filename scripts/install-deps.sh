@@ -15,6 +15,7 @@ PACKAGES=(
   libjpeg-dev                                        # JPEG pictures to query with (libjpeg-turbo)
   libflann-dev liblz4-dev                            # k-nearest-neighbour graph (RLD-SIFT)
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # services
+  libssl-dev                                         # OpenSSL, which gRPC's TLS uses: told not to tear down at exit
   libsqlite3-dev                                     # state of the stateful services
   zlib1g-dev                                         # CRC-32 of the coordinator's feature files
   prometheus-cpp-dev                                 # the services' Prometheus metrics (/metrics over HTTP)

@@ -1,6 +1,7 @@
 #include "common/rpc/credentials.h"
 
 #include <grpcpp/security/auth_metadata_processor.h>
+#include <openssl/crypto.h>
 
 #include <cerrno>
 #include <cstring>
@@ -16,6 +17,21 @@ namespace meshseek::rpc {
 namespace {
 
 constexpr char kHealthPrefix[] = "/grpc.health.v1.Health/";
+
+// OpenSSL 3 frees its global and per-thread state in an atexit handler
+// (OPENSSL_cleanup) that assumes every other thread has stopped. gRPC's
+// threads may still run when a process leaves main, and one that ends during
+// the cleanup frees its thread-local part of that state a second time: a
+// double free at exit, seen by ASan in security_test (openssl/openssl#6214,
+// grpc/grpc#38539). The operating system reclaims the memory anyway, so the
+// handler is never registered. The first OPENSSL_init_crypto call decides,
+// and libcpp-httplib makes one in its own library constructor, before any of
+// the executable's constructors; so this runs from .preinit_array, which the
+// dynamic loader calls before every shared library's initialisers (libcrypto
+// is loaded and relocated by then; its initialisation is idempotent).
+void KeepOpenSslStateUntilExit() { OPENSSL_init_crypto(OPENSSL_INIT_NO_ATEXIT, nullptr); }
+[[gnu::used, gnu::section(".preinit_array")]] void (*const kKeepOpenSslStateUntilExit)() =
+    &KeepOpenSslStateUntilExit;
 
 // Checks `authorization: Bearer <token>` on every call but health checks.
 // Runs inline in gRPC's transport (not blocking: a comparison), before the
