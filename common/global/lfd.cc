@@ -226,7 +226,7 @@ absl::StatusOr<std::vector<uint8_t>> ExtractLfd(const TriangleMesh& mesh,
     std::array<double, kLfdViewsPerLightField> radii;
     double shared = 0;
     for (int v = 0; v < kLfdViewsPerLightField; ++v) {
-      masks[v] = renderer->Render(Rotate(rotations[l], directions[v])).mask;
+      masks[v] = renderer->RenderSilhouette(Rotate(rotations[l], directions[v]));
       const BinaryImageView image{masks[v].data(), n, n};
       centroids[v] = ComputeCentroid(image);
       radii[v] = LargestRadius(image, centroids[v].x, centroids[v].y);

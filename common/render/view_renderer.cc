@@ -125,7 +125,10 @@ MESHSEEK_TARGET_CLONES_AVX void PixelSpans(std::size_t n,
 
 // The pixel centres of one triangle's box (x0..x1, y0..y1) that its closure
 // holds take its interpolated depth where it is the nearest surface so far
-// (largest depth; the earlier triangle on ties).
+// (largest depth; the earlier triangle on ties). kSilhouette: only the mask,
+// and a pixel already covered is not tested again (it stays covered whatever
+// the test says), so the mask is Render's.
+template <bool kSilhouette>
 inline void RasterizeTriangle(const double (&a)[3],
                               const double (&b)[3],
                               const double (&c)[3],
@@ -145,14 +148,19 @@ inline void RasterizeTriangle(const double (&a)[3],
   for (int y = y0; y <= y1; ++y) {
     const double sy = y + 0.5;
     for (int x = x0; x <= x1; ++x) {
+      const std::size_t at = static_cast<std::size_t>(y) * n + x;
+      if (kSilhouette && mask[at] != 0) continue;
       const double sx = x + 0.5;
       // Barycentric weights as signed sub-areas over the whole.
       const double wa = ((bx - sx) * (cy - sy) - (by - sy) * (cx - sx)) * inverse;
       const double wb = ((cx - sx) * (ay - sy) - (cy - sy) * (ax - sx)) * inverse;
       const double wc = 1.0 - wa - wb;
       if (wa < 0 || wb < 0 || wc < 0) continue;
+      if (kSilhouette) {
+        mask[at] = 1;
+        continue;
+      }
       const auto z = static_cast<float>(wa * a[2] + wb * b[2] + wc * c[2]);
-      const std::size_t at = static_cast<std::size_t>(y) * n + x;
       if (mask[at] == 0 || z > depth[at]) {
         depth[at] = z;
         mask[at] = 1;
@@ -162,23 +170,37 @@ inline void RasterizeTriangle(const double (&a)[3],
   }
 }
 
+// Whether every pixel of the box is covered already (kSilhouette: then the
+// triangle can change nothing).
+inline bool BoxCovered(const uint8_t* mask, int n, int x0, int x1, int y0, int y1) {
+  for (int y = y0; y <= y1; ++y) {
+    const uint8_t* row = mask + static_cast<std::size_t>(y) * n;
+    for (int x = x0; x <= x1; ++x) {
+      if (row[x] == 0) return false;
+    }
+  }
+  return true;
+}
+
 // Z-buffers `count` triangles of projected vertices (px, py, pz) into the
 // n x n image: a pixel takes the triangle nearest the camera (largest depth)
 // whose closure holds its centre, the first such in triangle order on ties.
 // Most triangles of a detailed mesh are smaller than a pixel and hold no
 // pixel centre, unpredictably: blocks of triangles are first culled without
 // branches from their corners' integer spans (PixelSpans), then the few left
-// are rasterised. Compiled wider too (gathers, and the rasteriser's rounding).
-MESHSEEK_TARGET_CLONES_AVX void Rasterize(const Triangle* triangles,
-                                          std::size_t count,
-                                          const double* px,
-                                          const double* py,
-                                          const double* pz,
-                                          const PixelSpanArrays& spans,
-                                          int n,
-                                          float* depth,
-                                          uint8_t* mask,
-                                          int32_t* face) {
+// are rasterised; for a silhouette, those whose box is covered already (the
+// surfaces behind the first) are skipped too.
+template <bool kSilhouette>
+[[gnu::always_inline]] inline void RasterizeBlocks(const Triangle* triangles,
+                                                   std::size_t count,
+                                                   const double* px,
+                                                   const double* py,
+                                                   const double* pz,
+                                                   const PixelSpanArrays& spans,
+                                                   int n,
+                                                   float* depth,
+                                                   uint8_t* mask,
+                                                   int32_t* face) {
   constexpr int kBlock = 64;
   for (std::size_t start = 0; start < count; start += kBlock) {
     const int m = static_cast<int>(std::min<std::size_t>(kBlock, count - start));
@@ -196,45 +218,95 @@ MESHSEEK_TARGET_CLONES_AVX void Rasterize(const Triangle* triangles,
     }
     for (int q = 0; q < num_kept; ++q) {
       const int j = kept[q];
+      if (kSilhouette && BoxCovered(mask, n, box[0][j], box[1][j], box[2][j], box[3][j])) continue;
       const Triangle& t = triangles[start + j];
       const double a[3] = {px[t[0]], py[t[0]], pz[t[0]]};
       const double b[3] = {px[t[1]], py[t[1]], pz[t[1]]};
       const double c[3] = {px[t[2]], py[t[2]], pz[t[2]]};
-      RasterizeTriangle(a, b, c, static_cast<int32_t>(start + j), box[0][j], box[1][j], box[2][j],
-                        box[3][j], n, depth, mask, face);
+      RasterizeTriangle<kSilhouette>(a, b, c, static_cast<int32_t>(start + j), box[0][j],
+                                     box[1][j], box[2][j], box[3][j], n, depth, mask, face);
     }
   }
+}
+
+// Compiled wider too (gathers, and the rasteriser's rounding).
+MESHSEEK_TARGET_CLONES_AVX void Rasterize(const Triangle* triangles,
+                                          std::size_t count,
+                                          const double* px,
+                                          const double* py,
+                                          const double* pz,
+                                          const PixelSpanArrays& spans,
+                                          int n,
+                                          float* depth,
+                                          uint8_t* mask,
+                                          int32_t* face) {
+  RasterizeBlocks<false>(triangles, count, px, py, pz, spans, n, depth, mask, face);
+}
+
+MESHSEEK_TARGET_CLONES_AVX void RasterizeSilhouette(const Triangle* triangles,
+                                                    std::size_t count,
+                                                    const double* px,
+                                                    const double* py,
+                                                    const PixelSpanArrays& spans,
+                                                    int n,
+                                                    uint8_t* mask) {
+  // No depths: px stands in for them (read, never used), so that nothing is null.
+  RasterizeBlocks<true>(triangles, count, px, py, px, spans, n, nullptr, mask, nullptr);
+}
+
+// The vertices of one view: screen x, y (pixel units) and depth, and each
+// one's span of pixel columns and rows (PixelSpans).
+struct Projection {
+  std::vector<double> x, y, depth;
+  std::vector<int16_t> first_col, last_col, first_row, last_row;
+
+  PixelSpanArrays spans() const {
+    return {first_col.data(), last_col.data(), first_row.data(), last_row.data()};
+  }
+};
+
+Projection Project(const std::vector<double>& x,
+                   const std::vector<double>& y,
+                   const std::vector<double>& z,
+                   const ViewCamera& frame,
+                   const ViewRenderOptions& options) {
+  const int n = options.image_size;
+  const double half = 0.5 * n;
+  const double to_pixels = half / options.window_scale;
+  const std::size_t count = x.size();
+  Projection p{std::vector<double>(count), std::vector<double>(count), std::vector<double>(count),
+               std::vector<int16_t>(count), std::vector<int16_t>(count),
+               std::vector<int16_t>(count), std::vector<int16_t>(count)};
+  ProjectVertices(count, x.data(), y.data(), z.data(), frame.right, frame.up, frame.direction,
+                  half, to_pixels, p.x.data(), p.y.data(), p.depth.data());
+  PixelSpans(count, p.x.data(), n, p.first_col.data(), p.last_col.data());
+  PixelSpans(count, p.y.data(), n, p.first_row.data(), p.last_row.data());
+  return p;
 }
 
 }  // namespace
 
 ViewImage ViewRenderer::Render(const ViewCamera& frame) const {
   const int n = options_.image_size;
-  const double half = 0.5 * n;
-  const double to_pixels = half / options_.window_scale;
   ViewImage image;
   image.size = n;
   image.depth.assign(static_cast<std::size_t>(n) * n, 0.0f);
   image.mask.assign(static_cast<std::size_t>(n) * n, 0);
   if (options_.record_faces) image.face.assign(static_cast<std::size_t>(n) * n, -1);
-  const std::size_t count = x_.size();
-  std::vector<double> projected(3 * count);
-  double* px = projected.data();
-  double* py = px + count;
-  double* pz = py + count;
-  ProjectVertices(count, x_.data(), y_.data(), z_.data(), frame.right, frame.up, frame.direction,
-                  half, to_pixels, px, py, pz);
-  std::vector<int16_t> spans(4 * count);
-  int16_t* first_col = spans.data();
-  int16_t* last_col = first_col + count;
-  int16_t* first_row = last_col + count;
-  int16_t* last_row = first_row + count;
-  PixelSpans(count, px, n, first_col, last_col);
-  PixelSpans(count, py, n, first_row, last_row);
-  Rasterize(triangles_.data(), triangles_.size(), px, py, pz,
-            {first_col, last_col, first_row, last_row}, n, image.depth.data(), image.mask.data(),
-            options_.record_faces ? image.face.data() : nullptr);
+  const Projection p = Project(x_, y_, z_, frame, options_);
+  Rasterize(triangles_.data(), triangles_.size(), p.x.data(), p.y.data(), p.depth.data(),
+            p.spans(), n, image.depth.data(),
+            image.mask.data(), options_.record_faces ? image.face.data() : nullptr);
   return image;
+}
+
+std::vector<uint8_t> ViewRenderer::RenderSilhouette(const ViewCamera& frame) const {
+  const int n = options_.image_size;
+  std::vector<uint8_t> mask(static_cast<std::size_t>(n) * n, 0);
+  const Projection p = Project(x_, y_, z_, frame, options_);
+  RasterizeSilhouette(triangles_.data(), triangles_.size(), p.x.data(), p.y.data(), p.spans(), n,
+                      mask.data());
+  return mask;
 }
 
 }  // namespace meshseek

@@ -81,6 +81,15 @@ class ViewRenderer {
   ViewImage Render(const Vec3d& direction) const { return Render(CameraFor(direction)); }
   ViewImage Render(const ViewCamera& frame) const;
 
+  /// Render(frame).mask alone, sooner: without depths, a pixel covered once
+  /// is not tested again and a triangle whose pixel box is covered already
+  /// is skipped, so the surfaces behind the first cost little (LFD's
+  /// silhouettes).
+  std::vector<uint8_t> RenderSilhouette(const Vec3d& direction) const {
+    return RenderSilhouette(CameraFor(direction));
+  }
+  std::vector<uint8_t> RenderSilhouette(const ViewCamera& frame) const;
+
   /// The enclosing sphere the views are framed by, in the mesh's coordinates.
   const Sphere& sphere() const { return sphere_; }
   const ViewRenderOptions& options() const { return options_; }

@@ -141,6 +141,33 @@ TEST(ViewRendererTest, SoupsAndSeveralComponentsRenderTheSame) {
   }
 }
 
+// The silhouette path skips pixels and triangles already covered: the same
+// mask, on meshes of many overlapping layers and triangles smaller than a
+// pixel, framed whole or cut by the window's edges.
+TEST(ViewRendererTest, SilhouetteIsTheMaskOfTheFullRender) {
+  TriangleMesh layered = testing_meshes::LumpyBlob(4);
+  TriangleMesh inner = testing_meshes::Icosphere(3, 0.6f);
+  testing_meshes::Append(inner, &layered);
+  testing_meshes::Append(testing_meshes::Cube(0.3f), &layered);
+  for (const int size : {16, 64, 128}) {
+    for (const double window : {1.0, 0.4}) {
+      ViewRenderOptions options;
+      options.image_size = size;
+      options.window_scale = window;
+      for (const TriangleMesh& mesh : {layered, testing_meshes::ToSoup(layered)}) {
+        auto renderer = ViewRenderer::Create(mesh, options);
+        ASSERT_TRUE(renderer.ok()) << renderer.status();
+        for (const Vec3d& d : IcosphereDirections(1)) {
+          const ViewCamera camera = CameraFor(d);
+          const std::vector<uint8_t> silhouette = renderer->RenderSilhouette(camera);
+          EXPECT_EQ(silhouette, renderer->Render(camera).mask)
+              << "size " << size << ", window " << window;
+        }
+      }
+    }
+  }
+}
+
 TEST(ViewRendererTest, RefusesWhatCannotBeFramed) {
   EXPECT_FALSE(ViewRenderer::Create(TriangleMesh(), {}).ok());
   TriangleMesh point;
