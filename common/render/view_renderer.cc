@@ -95,14 +95,6 @@ MESHSEEK_TARGET_CLONES_AVX void ProjectVertices(std::size_t n,
   }
 }
 
-// Per vertex, as PixelSpans computes them for columns (x) and rows (y).
-struct PixelSpanArrays {
-  const int16_t* first_col;
-  const int16_t* last_col;
-  const int16_t* first_row;
-  const int16_t* last_row;
-};
-
 // The pixel centres k + 0.5 a vertex at screen coordinate p could bound: a
 // triangle's first column is the least of its corners' ceil(p - 0.5), its
 // last the greatest floor(p - 0.5) (rounding is monotone, so the minimum
@@ -121,6 +113,32 @@ MESHSEEK_TARGET_CLONES_AVX void PixelSpans(std::size_t n,
     first[i] = static_cast<int16_t>(std::min(std::max(std::ceil(q), 0.0), beyond));
     last[i] = static_cast<int16_t>(std::min(std::max(std::floor(q), -1.0), end));
   }
+}
+
+// The vertices of one view: screen x, y (pixel units) and depth, and each
+// one's span of pixel columns and rows (PixelSpans).
+struct Projection {
+  std::vector<double> x, y, depth;
+  std::vector<int16_t> first_col, last_col, first_row, last_row;
+};
+
+Projection Project(const std::vector<double>& x,
+                   const std::vector<double>& y,
+                   const std::vector<double>& z,
+                   const ViewCamera& frame,
+                   const ViewRenderOptions& options) {
+  const int n = options.image_size;
+  const double half = 0.5 * n;
+  const double to_pixels = half / options.window_scale;
+  const std::size_t count = x.size();
+  Projection p{std::vector<double>(count), std::vector<double>(count), std::vector<double>(count),
+               std::vector<int16_t>(count), std::vector<int16_t>(count),
+               std::vector<int16_t>(count), std::vector<int16_t>(count)};
+  ProjectVertices(count, x.data(), y.data(), z.data(), frame.right, frame.up, frame.direction,
+                  half, to_pixels, p.x.data(), p.y.data(), p.depth.data());
+  PixelSpans(count, p.x.data(), n, p.first_col.data(), p.last_col.data());
+  PixelSpans(count, p.y.data(), n, p.first_row.data(), p.last_row.data());
+  return p;
 }
 
 // The pixel centres of one triangle's box (x0..x1, y0..y1) that its closure
@@ -182,8 +200,7 @@ inline bool BoxCovered(const uint8_t* mask, int n, int x0, int x1, int y0, int y
   return true;
 }
 
-// Z-buffers `count` triangles of projected vertices (px, py, pz) into the
-// n x n image: a pixel takes the triangle nearest the camera (largest depth)
+// Z-buffers the triangles, their vertices projected (p), into the n x n image: a pixel takes the triangle nearest the camera (largest depth)
 // whose closure holds its centre, the first such in triangle order on ties.
 // Most triangles of a detailed mesh are smaller than a pixel and hold no
 // pixel centre, unpredictably: blocks of triangles are first culled without
@@ -191,16 +208,19 @@ inline bool BoxCovered(const uint8_t* mask, int n, int x0, int x1, int y0, int y
 // are rasterised; for a silhouette, those whose box is covered already (the
 // surfaces behind the first) are skipped too.
 template <bool kSilhouette>
-[[gnu::always_inline]] inline void RasterizeBlocks(const Triangle* triangles,
-                                                   std::size_t count,
-                                                   const double* px,
-                                                   const double* py,
-                                                   const double* pz,
-                                                   const PixelSpanArrays& spans,
+[[gnu::always_inline]] inline void RasterizeBlocks(const std::vector<Triangle>& triangles,
+                                                   const Projection& p,
                                                    int n,
                                                    float* depth,
                                                    uint8_t* mask,
                                                    int32_t* face) {
+  // Raw pointers, loaded once: `mask` is bytes, and a store through it could
+  // otherwise be the vectors' own pointers as far as the compiler knows.
+  const std::size_t count = triangles.size();
+  const Triangle* tri = triangles.data();
+  const double *px = p.x.data(), *py = p.y.data(), *pz = p.depth.data();
+  const int16_t *first_col = p.first_col.data(), *last_col = p.last_col.data();
+  const int16_t *first_row = p.first_row.data(), *last_row = p.last_row.data();
   constexpr int kBlock = 64;
   for (std::size_t start = 0; start < count; start += kBlock) {
     const int m = static_cast<int>(std::min<std::size_t>(kBlock, count - start));
@@ -208,18 +228,18 @@ template <bool kSilhouette>
     int kept[kBlock];
     int num_kept = 0;
     for (int j = 0; j < m; ++j) {
-      const Triangle& t = triangles[start + j];
-      box[0][j] = std::min({spans.first_col[t[0]], spans.first_col[t[1]], spans.first_col[t[2]]});
-      box[1][j] = std::max({spans.last_col[t[0]], spans.last_col[t[1]], spans.last_col[t[2]]});
-      box[2][j] = std::min({spans.first_row[t[0]], spans.first_row[t[1]], spans.first_row[t[2]]});
-      box[3][j] = std::max({spans.last_row[t[0]], spans.last_row[t[1]], spans.last_row[t[2]]});
+      const Triangle& t = tri[start + j];
+      box[0][j] = std::min({first_col[t[0]], first_col[t[1]], first_col[t[2]]});
+      box[1][j] = std::max({last_col[t[0]], last_col[t[1]], last_col[t[2]]});
+      box[2][j] = std::min({first_row[t[0]], first_row[t[1]], first_row[t[2]]});
+      box[3][j] = std::max({last_row[t[0]], last_row[t[1]], last_row[t[2]]});
       kept[num_kept] = j;
       num_kept += (box[0][j] <= box[1][j]) & (box[2][j] <= box[3][j]);
     }
     for (int q = 0; q < num_kept; ++q) {
       const int j = kept[q];
       if (kSilhouette && BoxCovered(mask, n, box[0][j], box[1][j], box[2][j], box[3][j])) continue;
-      const Triangle& t = triangles[start + j];
+      const Triangle& t = tri[start + j];
       const double a[3] = {px[t[0]], py[t[0]], pz[t[0]]};
       const double b[3] = {px[t[1]], py[t[1]], pz[t[1]]};
       const double c[3] = {px[t[2]], py[t[2]], pz[t[2]]};
@@ -230,58 +250,20 @@ template <bool kSilhouette>
 }
 
 // Compiled wider too (gathers, and the rasteriser's rounding).
-MESHSEEK_TARGET_CLONES_AVX void Rasterize(const Triangle* triangles,
-                                          std::size_t count,
-                                          const double* px,
-                                          const double* py,
-                                          const double* pz,
-                                          const PixelSpanArrays& spans,
+MESHSEEK_TARGET_CLONES_AVX void Rasterize(const std::vector<Triangle>& triangles,
+                                          const Projection& p,
                                           int n,
                                           float* depth,
                                           uint8_t* mask,
                                           int32_t* face) {
-  RasterizeBlocks<false>(triangles, count, px, py, pz, spans, n, depth, mask, face);
+  RasterizeBlocks<false>(triangles, p, n, depth, mask, face);
 }
 
-MESHSEEK_TARGET_CLONES_AVX void RasterizeSilhouette(const Triangle* triangles,
-                                                    std::size_t count,
-                                                    const double* px,
-                                                    const double* py,
-                                                    const PixelSpanArrays& spans,
+MESHSEEK_TARGET_CLONES_AVX void RasterizeSilhouette(const std::vector<Triangle>& triangles,
+                                                    const Projection& p,
                                                     int n,
                                                     uint8_t* mask) {
-  // No depths: px stands in for them (read, never used), so that nothing is null.
-  RasterizeBlocks<true>(triangles, count, px, py, px, spans, n, nullptr, mask, nullptr);
-}
-
-// The vertices of one view: screen x, y (pixel units) and depth, and each
-// one's span of pixel columns and rows (PixelSpans).
-struct Projection {
-  std::vector<double> x, y, depth;
-  std::vector<int16_t> first_col, last_col, first_row, last_row;
-
-  PixelSpanArrays spans() const {
-    return {first_col.data(), last_col.data(), first_row.data(), last_row.data()};
-  }
-};
-
-Projection Project(const std::vector<double>& x,
-                   const std::vector<double>& y,
-                   const std::vector<double>& z,
-                   const ViewCamera& frame,
-                   const ViewRenderOptions& options) {
-  const int n = options.image_size;
-  const double half = 0.5 * n;
-  const double to_pixels = half / options.window_scale;
-  const std::size_t count = x.size();
-  Projection p{std::vector<double>(count), std::vector<double>(count), std::vector<double>(count),
-               std::vector<int16_t>(count), std::vector<int16_t>(count),
-               std::vector<int16_t>(count), std::vector<int16_t>(count)};
-  ProjectVertices(count, x.data(), y.data(), z.data(), frame.right, frame.up, frame.direction,
-                  half, to_pixels, p.x.data(), p.y.data(), p.depth.data());
-  PixelSpans(count, p.x.data(), n, p.first_col.data(), p.last_col.data());
-  PixelSpans(count, p.y.data(), n, p.first_row.data(), p.last_row.data());
-  return p;
+  RasterizeBlocks<true>(triangles, p, n, nullptr, mask, nullptr);
 }
 
 }  // namespace
@@ -294,9 +276,8 @@ ViewImage ViewRenderer::Render(const ViewCamera& frame) const {
   image.mask.assign(static_cast<std::size_t>(n) * n, 0);
   if (options_.record_faces) image.face.assign(static_cast<std::size_t>(n) * n, -1);
   const Projection p = Project(x_, y_, z_, frame, options_);
-  Rasterize(triangles_.data(), triangles_.size(), p.x.data(), p.y.data(), p.depth.data(),
-            p.spans(), n, image.depth.data(),
-            image.mask.data(), options_.record_faces ? image.face.data() : nullptr);
+  Rasterize(triangles_, p, n, image.depth.data(), image.mask.data(),
+            options_.record_faces ? image.face.data() : nullptr);
   return image;
 }
 
@@ -304,8 +285,7 @@ std::vector<uint8_t> ViewRenderer::RenderSilhouette(const ViewCamera& frame) con
   const int n = options_.image_size;
   std::vector<uint8_t> mask(static_cast<std::size_t>(n) * n, 0);
   const Projection p = Project(x_, y_, z_, frame, options_);
-  RasterizeSilhouette(triangles_.data(), triangles_.size(), p.x.data(), p.y.data(), p.spans(), n,
-                      mask.data());
+  RasterizeSilhouette(triangles_, p, n, mask.data());
   return mask;
 }
 
