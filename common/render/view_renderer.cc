@@ -200,8 +200,9 @@ inline bool BoxCovered(const uint8_t* mask, int n, int x0, int x1, int y0, int y
   return true;
 }
 
-// Z-buffers the triangles, their vertices projected (p), into the n x n image: a pixel takes the triangle nearest the camera (largest depth)
-// whose closure holds its centre, the first such in triangle order on ties.
+// Z-buffers the triangles, their vertices projected (p), into the n x n
+// image: a pixel takes the triangle nearest the camera (largest depth) whose
+// closure holds its centre, the first such in triangle order on ties.
 // Most triangles of a detailed mesh are smaller than a pixel and hold no
 // pixel centre, unpredictably: blocks of triangles are first culled without
 // branches from their corners' integer spans (PixelSpans), then the few left
