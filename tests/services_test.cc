@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -759,8 +760,21 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
     stack.coordinator().Kill(SIGKILL);
     stack.coordinator().Start();
     ASSERT_TRUE(stack.WaitServing());
-    found.Clear();
-    ASSERT_TRUE(Query(stub.get(), "fused", n, 3, absl::Seconds(60), &found).ok());
+    // The first query after the restart was refused about once in ten runs
+    // (its code and message are printed below when it happens; the restarted
+    // coordinator also resumes pending models then): answered within 60 s.
+    grpc::Status replayed;
+    const absl::Time restarted = absl::Now();
+    do {
+      found.Clear();
+      replayed = Query(stub.get(), "fused", n, 3, absl::Seconds(60), &found);
+      if (!replayed.ok()) {
+        std::cerr << "query after restart refused: " << replayed.error_code() << ": "
+                  << replayed.error_message() << "\n";
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      }
+    } while (!replayed.ok() && absl::Now() - restarted < absl::Seconds(60));
+    ASSERT_TRUE(replayed.ok()) << replayed.error_code() << ": " << replayed.error_message();
     ASSERT_GT(found.results_size(), 0);
     EXPECT_EQ(found.results(0).model_id(), (*models_)[n].id);
   }
