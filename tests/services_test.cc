@@ -760,9 +760,12 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
     stack.coordinator().Kill(SIGKILL);
     stack.coordinator().Start();
     ASSERT_TRUE(stack.WaitServing());
-    // The first query after the restart was refused about once in ten runs
-    // (its code and message are printed below when it happens; the restarted
-    // coordinator also resumes pending models then): answered within 60 s.
+    // The test's channel saw the coordinator's port refuse connections while
+    // it was down and may still be in reconnect backoff when the restarted one
+    // serves: about once in ten runs the first query then fails at once with
+    // UNAVAILABLE ("connections to all backends failing ... Connection
+    // refused"), as gRPC does for a call without wait_for_ready. Retried
+    // (each refusal printed) until answered, within 60 s.
     grpc::Status replayed;
     const absl::Time restarted = absl::Now();
     do {
