@@ -8,7 +8,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <iostream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -290,11 +289,14 @@ class ServicesTest : public ::testing::Test {
   }
 
   // Query with model i's mesh, top_k results; `deadline` for the whole call.
+  // `wait_for_ready`: wait within it for the channel to connect instead of
+  // failing at once while the channel is in reconnect backoff.
   static grpc::Status Query(v1::Coordinator::Stub* stub, const std::string& collection,
                             std::size_t i, uint32_t top_k, absl::Duration deadline,
-                            v1::QueryResponse* response) {
+                            v1::QueryResponse* response, bool wait_for_ready = false) {
     grpc::ClientContext context;
     rpc::SetDeadline(&context, deadline);
+    context.set_wait_for_ready(wait_for_ready);
     v1::QueryRequest request;
     request.set_collection(collection);
     request.set_top_k(top_k);
@@ -762,21 +764,12 @@ TEST_F(ServicesTest, AFusedRerankedCollectionSurvivesKillsAndEqualsInProcess) {
     ASSERT_TRUE(stack.WaitServing());
     // The test's channel saw the coordinator's port refuse connections while
     // it was down and may still be in reconnect backoff when the restarted one
-    // serves: about once in ten runs the first query then fails at once with
-    // UNAVAILABLE ("connections to all backends failing ... Connection
-    // refused"), as gRPC does for a call without wait_for_ready. Retried
-    // (each refusal printed) until answered, within 60 s.
-    grpc::Status replayed;
-    const absl::Time restarted = absl::Now();
-    do {
-      found.Clear();
-      replayed = Query(stub.get(), "fused", n, 3, absl::Seconds(60), &found);
-      if (!replayed.ok()) {
-        std::cerr << "query after restart refused: " << replayed.error_code() << ": "
-                  << replayed.error_message() << "\n";
-        std::this_thread::sleep_for(std::chrono::milliseconds(200));
-      }
-    } while (!replayed.ok() && absl::Now() - restarted < absl::Seconds(60));
+    // serves: without wait_for_ready the first query then failed at once,
+    // about once in ten runs, with UNAVAILABLE ("connections to all backends
+    // failing ... Connection refused").
+    found.Clear();
+    const grpc::Status replayed =
+        Query(stub.get(), "fused", n, 3, absl::Seconds(60), &found, /*wait_for_ready=*/true);
     ASSERT_TRUE(replayed.ok()) << replayed.error_code() << ": " << replayed.error_message();
     ASSERT_GT(found.results_size(), 0);
     EXPECT_EQ(found.results(0).model_id(), (*models_)[n].id);
