@@ -47,12 +47,8 @@ uint32_t TriangleBvh::Build(uint32_t begin,
     box.Extend(boxes[order_[i]]);
     centroid_box.Extend(centroids[order_[i]]);
   }
-  nodes_[index].box = box;
-  if (end - begin <= static_cast<uint32_t>(kLeafSize)) {
-    nodes_[index].first = begin;
-    nodes_[index].count = end - begin;
-    return index;
-  }
+  nodes_[index] = {box, begin, end, 0};
+  if (end - begin <= static_cast<uint32_t>(kLeafSize)) return index;
   const Vec3f extent = centroid_box.max - centroid_box.min;
   const int axis =
       extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
@@ -65,9 +61,7 @@ uint32_t TriangleBvh::Build(uint32_t begin,
                      return ca < cb || (ca == cb && a < b);
                    });
   Build(begin, mid, boxes, centroids);
-  const uint32_t right = Build(mid, end, boxes, centroids);
-  nodes_[index].first = right;
-  nodes_[index].count = 0;
+  nodes_[index].right = Build(mid, end, boxes, centroids);
   return index;
 }
 
@@ -99,25 +93,39 @@ auto OrientedBoxTest(const OrientedBox& box) {
     OrientedBox box;
     double abs_axes[3][3];  // |axes[i][j]|
     double spread[3][3];    // half_extents[i] |axes[i][j]|
-    bool operator()(const Aabb& b) const {
+    // A node is inside when its box is this far within every face (a
+    // billionth of the half extent), so that rounding cannot fail a box
+    // inside it on the overlap tests; were it to, the caller would get a few
+    // triangles it rejects anyway.
+    double inner[3];
+    BoxRelation operator()(const Aabb& b) const {
       const Vec3d box_center = (Vec3d(b.min) + Vec3d(b.max)) * 0.5;
       const Vec3d box_half = (Vec3d(b.max) - Vec3d(b.min)) * 0.5;
       const Vec3d d = box.center - box_center;
       for (int j = 0; j < 3; ++j) {
         double reach = box_half[j];
         for (int i = 0; i < 3; ++i) reach += spread[i][j];
-        if (std::abs(d[j]) > reach) return false;
+        if (std::abs(d[j]) > reach) return BoxRelation::kOutside;
       }
+      bool inside = true;
       for (int i = 0; i < 3; ++i) {
         double reach = box.half_extents[i];
-        for (int j = 0; j < 3; ++j) reach += box_half[j] * abs_axes[i][j];
-        if (std::abs(Dot(d, box.axes[i])) > reach) return false;
+        double half_width = 0;  // of b along axis i
+        for (int j = 0; j < 3; ++j) {
+          const double w = box_half[j] * abs_axes[i][j];
+          reach += w;
+          half_width += w;
+        }
+        const double offset = std::abs(Dot(d, box.axes[i]));
+        if (offset > reach) return BoxRelation::kOutside;
+        inside = inside && offset + half_width <= inner[i];
       }
-      return true;
+      return inside ? BoxRelation::kInside : BoxRelation::kOverlaps;
     }
   };
-  Test test{box, {}, {}};
+  Test test{box, {}, {}, {}};
   for (int i = 0; i < 3; ++i) {
+    test.inner[i] = box.half_extents[i] * (1 - 1e-9);
     for (int j = 0; j < 3; ++j) {
       test.abs_axes[i][j] = std::abs(box.axes[i][j]);
       test.spread[i][j] = box.half_extents[i] * test.abs_axes[i][j];
@@ -129,23 +137,31 @@ auto OrientedBoxTest(const OrientedBox& box) {
 }  // namespace
 
 void TriangleBvh::Query(const Aabb& box, std::vector<uint32_t>* out) const {
-  Traverse([&box](const Aabb& b) { return b.Overlaps(box); },
-           [&](uint32_t first, uint32_t count) {
-             out->insert(out->end(), order_.begin() + first, order_.begin() + first + count);
-           });
+  Traverse(
+      [&box](const Aabb& b) {
+        if (!b.Overlaps(box)) return BoxRelation::kOutside;
+        const bool inside = box.min.x <= b.min.x && b.max.x <= box.max.x && box.min.y <= b.min.y &&
+                            b.max.y <= box.max.y && box.min.z <= b.min.z && b.max.z <= box.max.z;
+        return inside ? BoxRelation::kInside : BoxRelation::kOverlaps;
+      },
+      [&](uint32_t begin, uint32_t end) {
+        out->insert(out->end(), order_.begin() + begin, order_.begin() + end);
+      });
 }
 
 void TriangleBvh::Query(const OrientedBox& box, std::vector<uint32_t>* out) const {
-  Traverse(OrientedBoxTest(box), [&](uint32_t first, uint32_t count) {
-    out->insert(out->end(), order_.begin() + first, order_.begin() + first + count);
+  Traverse(OrientedBoxTest(box), [&](uint32_t begin, uint32_t end) {
+    out->insert(out->end(), order_.begin() + begin, order_.begin() + end);
   });
 }
 
 // Leaves are tested by their node box only: a leaf's few triangles are cheaper
 // to hand to the caller, which rejects far ones in its own first step, than to
-// test box by box.
-template <typename Overlaps, typename Leaf>
-void TriangleBvh::Traverse(const Overlaps& overlaps, const Leaf& leaf) const {
+// test box by box. A node inside the query box is not descended: a large view
+// cube of a dense mesh holds thousands of triangles, and their subtrees were
+// most of the nodes tested.
+template <typename Classify, typename Emit>
+void TriangleBvh::Traverse(const Classify& classify, const Emit& emit) const {
   if (nodes_.empty()) return;
   uint32_t stack[64];
   int top = 0;
@@ -153,12 +169,13 @@ void TriangleBvh::Traverse(const Overlaps& overlaps, const Leaf& leaf) const {
   while (top > 0) {
     const uint32_t index = stack[--top];
     const Node& node = nodes_[index];
-    if (!overlaps(node.box)) continue;
-    if (node.count > 0) {
-      leaf(node.first, node.count);
+    const BoxRelation relation = classify(node.box);
+    if (relation == BoxRelation::kOutside) continue;
+    if (relation == BoxRelation::kInside || node.right == 0) {
+      emit(node.begin, node.end);
     } else {
-      stack[top++] = node.first;  // right child
-      stack[top++] = index + 1;   // left child (depth-first layout)
+      stack[top++] = node.right;
+      stack[top++] = index + 1;  // left child (depth-first layout)
     }
   }
 }

@@ -42,6 +42,9 @@ struct OrientedBox {
   bool MayOverlap(const Aabb& box) const;
 };
 
+// Where a node's box lies against a query box.
+enum class BoxRelation { kOutside, kOverlaps, kInside };
+
 class TriangleBvh {
  public:
   static constexpr int kLeafSize = 8;
@@ -62,19 +65,24 @@ class TriangleBvh {
   std::size_t num_nodes() const { return nodes_.size(); }
 
  private:
+  // Every node owns order_[begin, end): its subtree's triangles, contiguous
+  // in depth-first order, so a node inside the query box is emitted whole.
   struct Node {
     Aabb box;
-    uint32_t first;  // leaf: first index into order_; inner: index of the right child
-    uint32_t count;  // leaf: number of triangles; inner: 0
+    uint32_t begin;
+    uint32_t end;
+    uint32_t right;  // inner: index of the right child; leaf: 0
   };
   uint32_t Build(uint32_t begin,
                  uint32_t end,
                  const std::vector<Aabb>& boxes,
                  const std::vector<Vec3f>& centroids);
-  // Calls leaf(first, count) for every leaf whose box passes `overlaps`
-  // (first: position in order_), depth first.
-  template <typename Overlaps, typename Leaf>
-  void Traverse(const Overlaps& overlaps, const Leaf& leaf) const;
+  // Calls emit(begin, end) (positions in order_), depth first, for every leaf
+  // whose box `classify` does not find kOutside and, in one call, for every
+  // node it finds kInside: the same triangles in the same order as visiting
+  // that node's leaves, which a box inside the query box all overlap.
+  template <typename Classify, typename Emit>
+  void Traverse(const Classify& classify, const Emit& emit) const;
 
   std::vector<Node> nodes_;
   std::vector<uint32_t> order_;
