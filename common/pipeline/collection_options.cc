@@ -15,12 +15,22 @@ CollectionOptions::CollectionOptions() : methods({RetrievalPipelineOptions()}), 
   rerank.method = RerankOptions::Method::kNone;
 }
 
+RetrievalPipelineOptions CollectionOptions::FusedMember(FeatureMethod method) {
+  RetrievalPipelineOptions options = RetrievalPipelineOptions::ForMethod(method);
+  if (method == FeatureMethod::kRldSift) {
+    options.extractor.rld.num_samples = kFusedRldSamples;
+    options.kmeans.max_iterations = kFusedRldKMeansIterations;
+  }
+  return options;
+}
+
 CollectionOptions CollectionOptions::ForMethods(const std::vector<FeatureMethod>& methods) {
   CollectionOptions options;
   options.methods.clear();
   options.weights.clear();
   for (FeatureMethod m : methods) {
-    options.methods.push_back(RetrievalPipelineOptions::ForMethod(m));
+    options.methods.push_back(methods.size() > 1 ? FusedMember(m)
+                                                 : RetrievalPipelineOptions::ForMethod(m));
     options.weights.push_back(FeatureMethodInfoOf(m).fusion_weight);
   }
   // Measured: re-ranking a fusion gains 8 to 11 points of first tier on the

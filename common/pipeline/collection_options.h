@@ -35,8 +35,21 @@ struct CollectionOptions {
   /// DLD-SIFT alone.
   CollectionOptions();
   /// Each method with its defaults, in this order, the fusion and re-ranking
-  /// defaults for that many methods.
+  /// defaults for that many methods. Several methods are each a FusedMember.
   static CollectionOptions ForMethods(const std::vector<FeatureMethod>& methods);
+  /// A method's defaults as a member of a fusion: its own (ForMethod) but for
+  /// RLD-SIFT, which resamples kFusedRldSamples points and trains its
+  /// codebook in kFusedRldKMeansIterations Lloyd iterations. Half the paper's
+  /// N_RLD detects half the points (the supports s = C d sqrt(l) follow the
+  /// graph's spacing d) and halves RLD-SIFT's extraction (137 -> 77 ms a
+  /// McGill model). Alone that costs RLD-SIFT 2.6 points of first tier on
+  /// McGill (80.6 -> 78.0), so the method alone keeps the paper's 15,000 and
+  /// 25 iterations; in the default fusion first tier is 94.51 against 94.27
+  /// (McGill) and 62.53 against 62.40 (PSB train), nearest neighbour 99.22
+  /// and 78.76 against 98.82 and 77.54 (bench/results/speed_extract_fused.txt).
+  static RetrievalPipelineOptions FusedMember(FeatureMethod method);
+  static constexpr int kFusedRldSamples = 7500;
+  static constexpr int kFusedRldKMeansIterations = 6;
   /// One method with these options, no re-ranking.
   static CollectionOptions Of(const RetrievalPipelineOptions& method);
 

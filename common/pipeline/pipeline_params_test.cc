@@ -36,6 +36,33 @@ TEST(PipelineParamsTest, EveryMethodIsRegisteredOnceWithValidDefaults) {
   EXPECT_EQ(RetrievalPipelineOptions::ForMethod(FeatureMethod::kDldSift).kmeans.max_iterations, 25);
 }
 
+// RLD-SIFT alone keeps the paper's N_RLD; in a fusion it resamples half as
+// many points (CollectionOptions::FusedMember); every other member is its
+// method's own defaults, and a user's value still wins.
+TEST(PipelineParamsTest, AFusionsRldSiftMemberResamplesHalfThePapersPoints) {
+  const auto alone = CollectionOptionsFromValues({{"method", "rld"}});
+  ASSERT_TRUE(alone.ok()) << alone.status();
+  EXPECT_EQ(alone->methods[0].extractor.rld.num_samples, 15000);
+  EXPECT_EQ(alone->methods[0].kmeans.max_iterations, 25);
+  const auto fused = CollectionOptionsFromValues({{"method", "bfdsift+rld+lsf+lfd"}});
+  ASSERT_TRUE(fused.ok()) << fused.status();
+  for (const RetrievalPipelineOptions& member : fused->methods) {
+    const FeatureMethod method = member.extractor.method;
+    if (method == FeatureMethod::kRldSift) {
+      EXPECT_EQ(member.extractor.rld.num_samples, 7500);
+      EXPECT_EQ(member.kmeans.max_iterations, 6);
+    } else {
+      EXPECT_EQ(PipelineValuesOf(member),
+                PipelineValuesOf(RetrievalPipelineOptions::ForMethod(method)))
+          << FeatureMethodName(method);
+    }
+  }
+  const auto chosen =
+      CollectionOptionsFromValues({{"method", "bfdsift+rld"}, {"rld.rld_samples", "15000"}});
+  ASSERT_TRUE(chosen.ok()) << chosen.status();
+  EXPECT_EQ(chosen->methods[1].extractor.rld.num_samples, 15000);
+}
+
 TEST(PipelineParamsTest, NamesAreUniqueAndEveryDefaultLiesInItsOwnRange) {
   std::set<std::string> names;
   for (const ParamSpec& spec : PipelineParamSpecs()) {

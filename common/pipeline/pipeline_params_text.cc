@@ -1,6 +1,7 @@
 // metrics.json's parameter block and the --help listing, from the parameter
 // table (pipeline_params.h).
 #include <cstdint>
+#include <cstring>
 #include <set>
 #include <string>
 #include <vector>
@@ -100,14 +101,17 @@ std::string PipelineParamsUsage() {
                       "\n");
       continue;
     }
-    // "default: 20" when every method has the same, else "default: rld 15, ld 20".
+    // "default: 20" when every method has the same, else "default: rld 15, ld 20";
+    // "rld 15000 (7500 fused)" where a fusion's member differs.
     std::vector<std::string> defaults;
     std::set<std::string> distinct;
     for (const FeatureMethodInfo& info : FeatureMethods()) {
       if (spec.name == "method" || !spec.AppliesTo(info.method)) continue;
       const std::string value = spec.get(Options::ForMethod(info.method));
+      const std::string fused = spec.get(CollectionOptions::FusedMember(info.method));
       defaults.push_back(absl::StrCat(info.name, " ", value));
-      distinct.insert(value);
+      if (fused != value) absl::StrAppend(&defaults.back(), " (", fused, " fused)");
+      distinct.insert(defaults.back().substr(std::strlen(info.name) + 1));
     }
     if (distinct.size() == 1) defaults = {*distinct.begin()};
     absl::StrAppend(&usage, "  --", spec.name, "  ", spec.TypeDescription(), "; ", spec.doc, "\n");
