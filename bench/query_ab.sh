@@ -8,7 +8,10 @@
 # each round's median wall time (CLI start to ranked list out) and the
 # coordinator's signatures stage, then the medians over all rounds and their
 # ratio. BASE and NEW are meshseek binaries whose stores read each other's.
-#   bench/query_ab.sh BASE NEW MANIFEST [QUERIES] [ROUNDS]
+# BASE_COLLECTION_FLAGS, when set, compares collection parameters instead of
+# code: NEW also ingests and builds a second collection made with those flags
+# (e.g. "--rld.rld_samples=15000"), and BASE's turns query that one.
+#   [BASE_COLLECTION_FLAGS=...] bench/query_ab.sh BASE NEW MANIFEST [QUERIES] [ROUNDS]
 set -euo pipefail
 BASE=${1:?usage: bench/query_ab.sh BASE NEW MANIFEST [QUERIES] [ROUNDS]}
 NEW=${2:?usage}
@@ -32,19 +35,28 @@ echo "# bench/query_ab.sh $BASE $NEW $MANIFEST $QUERIES $ROUNDS: $(date -u '+%F 
 port=$(serve "$NEW")
 timeout 1800 "$NEW" --server "127.0.0.1:$port" --progress=false ingest --collection bench --manifest "$MANIFEST" | tail -1
 timeout 1800 "$NEW" --server "127.0.0.1:$port" --progress=false build --collection bench | tail -1
+BASE_COLLECTION=bench
+if [ -n "${BASE_COLLECTION_FLAGS:-}" ]; then
+  BASE_COLLECTION=bench_base
+  # shellcheck disable=SC2086  # the flags are words
+  timeout 1800 "$NEW" --server "127.0.0.1:$port" --progress=false ingest --collection bench_base \
+    --manifest "$MANIFEST" $BASE_COLLECTION_FLAGS | tail -1
+  timeout 1800 "$NEW" --server "127.0.0.1:$port" --progress=false build --collection bench_base | tail -1
+fi
 stop
 dir=$(dirname "$MANIFEST")
 mapfile -t files < <(tail -n +2 "$MANIFEST" | head -n "$QUERIES" | while IFS=, read -r _ _ path; do
   [[ $path = /* ]] && echo "$path" || echo "$dir/$path"; done)
 for round in $(seq "$ROUNDS"); do
   for variant in base new; do
-    bin=$BASE; [ "$variant" = new ] && bin=$NEW
+    bin=$BASE collection=$BASE_COLLECTION
+    [ "$variant" = new ] && bin=$NEW collection=bench
     port=$(serve "$bin")
-    "$bin" --server "127.0.0.1:$port" --progress=false query --collection bench --top_k 10 \
+    "$bin" --server "127.0.0.1:$port" --progress=false query --collection "$collection" --top_k 10 \
       --format json "${files[0]}" > /dev/null  # warm: the codebooks and index load
     for file in "${files[@]}"; do
       t0=$(date +%s.%N)
-      json=$("$bin" --server "127.0.0.1:$port" --progress=false query --collection bench \
+      json=$("$bin" --server "127.0.0.1:$port" --progress=false query --collection "$collection" \
         --top_k 10 --format json "$file")
       t1=$(date +%s.%N)
       python3 -c 'import json, sys
