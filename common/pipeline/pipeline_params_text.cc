@@ -1,7 +1,6 @@
 // metrics.json's parameter block and the --help listing, from the parameter
 // table (pipeline_params.h).
 #include <cstdint>
-#include <cstring>
 #include <set>
 #include <string>
 #include <vector>
@@ -107,11 +106,11 @@ std::string PipelineParamsUsage() {
     std::set<std::string> distinct;
     for (const FeatureMethodInfo& info : FeatureMethods()) {
       if (spec.name == "method" || !spec.AppliesTo(info.method)) continue;
-      const std::string value = spec.get(Options::ForMethod(info.method));
+      std::string value = spec.get(Options::ForMethod(info.method));
       const std::string fused = spec.get(CollectionOptions::FusedMember(info.method));
+      if (fused != value) absl::StrAppend(&value, " (", fused, " fused)");
       defaults.push_back(absl::StrCat(info.name, " ", value));
-      if (fused != value) absl::StrAppend(&defaults.back(), " (", fused, " fused)");
-      distinct.insert(defaults.back().substr(std::strlen(info.name) + 1));
+      distinct.insert(value);
     }
     if (distinct.size() == 1) defaults = {*distinct.begin()};
     absl::StrAppend(&usage, "  --", spec.name, "  ", spec.TypeDescription(), "; ", spec.doc, "\n");
