@@ -21,6 +21,9 @@ RetrievalPipelineOptions CollectionOptions::FusedMember(FeatureMethod method) {
     options.extractor.rld.num_samples = kFusedRldSamples;
     options.kmeans.max_iterations = kFusedRldKMeansIterations;
   }
+  if (method == FeatureMethod::kBfDsift) {
+    options.extractor.bfdsift.patch_image.image_size = kFusedBfDsiftPatchSize;
+  }
   return options;
 }
 

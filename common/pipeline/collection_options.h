@@ -38,7 +38,9 @@ struct CollectionOptions {
   /// defaults for that many methods. Several methods are each a FusedMember.
   static CollectionOptions ForMethods(const std::vector<FeatureMethod>& methods);
   /// A method's defaults as a member of a fusion: its own (ForMethod) but for
-  /// RLD-SIFT, which resamples kFusedRldSamples points and trains its
+  /// RLD-SIFT and BF-DSIFT.
+  ///
+  /// RLD-SIFT resamples kFusedRldSamples points and trains its
   /// codebook in kFusedRldKMeansIterations Lloyd iterations. Half the paper's
   /// N_RLD detects half the points (the supports s = C d sqrt(l) follow the
   /// graph's spacing d) and halves RLD-SIFT's extraction (137 -> 77 ms a
@@ -47,9 +49,21 @@ struct CollectionOptions {
   /// 25 iterations; in the default fusion first tier is 94.51 against 94.27
   /// (McGill) and 62.53 against 62.40 (PSB train), nearest neighbour 99.22
   /// and 78.76 against 98.82 and 77.54 (bench/results/speed_extract_fused.txt).
+  ///
+  /// BF-DSIFT resamples each of its ~25,000 patches a model into a
+  /// kFusedBfDsiftPatchSize-pixel square instead of 21 (the same patches,
+  /// radii and points; SIFT's 4 x 4 cells over 17 pixels instead of 21):
+  /// SIFT's work, most of BF-DSIFT's extraction, follows the pixels (0.66).
+  /// BF-DSIFT's extraction 0.79 of the time (mean of two alternated runs
+  /// on McGill's first 50), the whole fused McGill eval 0.88; the default
+  /// fusion's first tier 94.43 against 94.51 (McGill) and 62.23 against
+  /// 62.53 (PSB train), nearest neighbour the same (99.22, 78.76): within
+  /// the 0.3 issue 38 allows (bench/results/bfdsift.txt, round 4). 15 pixels
+  /// lost 0.18 on McGill; BF-DSIFT alone keeps 21 (not measured alone at 17).
   static RetrievalPipelineOptions FusedMember(FeatureMethod method);
   static constexpr int kFusedRldSamples = 7500;
   static constexpr int kFusedRldKMeansIterations = 6;
+  static constexpr int kFusedBfDsiftPatchSize = 17;
   /// One method with these options, no re-ranking.
   static CollectionOptions Of(const RetrievalPipelineOptions& method);
 

@@ -36,14 +36,18 @@ TEST(PipelineParamsTest, EveryMethodIsRegisteredOnceWithValidDefaults) {
   EXPECT_EQ(RetrievalPipelineOptions::ForMethod(FeatureMethod::kDldSift).kmeans.max_iterations, 25);
 }
 
-// RLD-SIFT alone keeps the paper's N_RLD; in a fusion it resamples half as
-// many points (CollectionOptions::FusedMember); every other member is its
+// RLD-SIFT alone keeps the paper's N_RLD and BF-DSIFT its 21-pixel patches;
+// in a fusion RLD-SIFT resamples half as many points and BF-DSIFT's patches
+// are 17 pixels (CollectionOptions::FusedMember); every other member is its
 // method's own defaults, and a user's value still wins.
-TEST(PipelineParamsTest, AFusionsRldSiftMemberResamplesHalfThePapersPoints) {
+TEST(PipelineParamsTest, AFusionsRldSiftAndBfDsiftMembersAreLighter) {
   const auto alone = CollectionOptionsFromValues({{"method", "rld"}});
   ASSERT_TRUE(alone.ok()) << alone.status();
   EXPECT_EQ(alone->methods[0].extractor.rld.num_samples, 15000);
   EXPECT_EQ(alone->methods[0].kmeans.max_iterations, 25);
+  const auto bf_alone = CollectionOptionsFromValues({{"method", "bfdsift"}});
+  ASSERT_TRUE(bf_alone.ok()) << bf_alone.status();
+  EXPECT_EQ(bf_alone->methods[0].extractor.bfdsift.patch_image.image_size, 21);
   const auto fused = CollectionOptionsFromValues({{"method", "bfdsift+rld+lsf+lfd"}});
   ASSERT_TRUE(fused.ok()) << fused.status();
   for (const RetrievalPipelineOptions& member : fused->methods) {
@@ -51,6 +55,8 @@ TEST(PipelineParamsTest, AFusionsRldSiftMemberResamplesHalfThePapersPoints) {
     if (method == FeatureMethod::kRldSift) {
       EXPECT_EQ(member.extractor.rld.num_samples, 7500);
       EXPECT_EQ(member.kmeans.max_iterations, 6);
+    } else if (method == FeatureMethod::kBfDsift) {
+      EXPECT_EQ(member.extractor.bfdsift.patch_image.image_size, 17);
     } else {
       EXPECT_EQ(PipelineValuesOf(member),
                 PipelineValuesOf(RetrievalPipelineOptions::ForMethod(method)))
@@ -61,6 +67,10 @@ TEST(PipelineParamsTest, AFusionsRldSiftMemberResamplesHalfThePapersPoints) {
       CollectionOptionsFromValues({{"method", "bfdsift+rld"}, {"rld.rld_samples", "15000"}});
   ASSERT_TRUE(chosen.ok()) << chosen.status();
   EXPECT_EQ(chosen->methods[1].extractor.rld.num_samples, 15000);
+  const auto bf_chosen =
+      CollectionOptionsFromValues({{"method", "bfdsift+rld"}, {"bfdsift.image_size", "21"}});
+  ASSERT_TRUE(bf_chosen.ok()) << bf_chosen.status();
+  EXPECT_EQ(bf_chosen->methods[0].extractor.bfdsift.patch_image.image_size, 21);
 }
 
 TEST(PipelineParamsTest, NamesAreUniqueAndEveryDefaultLiesInItsOwnRange) {
